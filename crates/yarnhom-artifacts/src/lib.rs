@@ -1,0 +1,171 @@
+//! yarnhom's artifacts: every file a yarnhom stage reads or writes.
+//!
+//! - [`container`]: the versioned `.yh` framing shared by every kind (magic, header, zstd
+//!   msgpack payload, checksum), atomic writes, migrations of older schema versions.
+//! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`).
+//! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
+//! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
+//! - [`schema`]: JSON Schemas generated from the types.
+
+pub mod check;
+pub mod container;
+pub mod error;
+#[cfg(feature = "hdf5")]
+pub mod hdf5;
+pub mod pattern;
+pub mod pyp;
+pub mod schema;
+pub mod yarnmodel;
+
+use serde::{Deserialize, Serialize, de::DeserializeOwned};
+
+pub use container::{Header, InputRef, Producer, Provenance, RawArtifact};
+pub use error::{Error, Result, ValidationError};
+pub use pattern::{Fabric, Pattern, RestState, Yarn};
+pub use yarnmodel::{YarnMechanics, YarnModel};
+
+/// A kind of artifact: a serde type with a name, a schema version, invariants and migrations.
+pub trait Artifact: Serialize + DeserializeOwned + schemars::JsonSchema {
+    /// The kind's name in headers and file names (`<name>.<KIND>.yh`).
+    const KIND: &'static str;
+    /// The current schema version of the payload.
+    const SCHEMA_VERSION: u32;
+    /// Check the kind's invariants.
+    fn validate(&self) -> std::result::Result<(), ValidationError>;
+    /// A human summary for `yarnhom inspect`.
+    fn summary(&self) -> String;
+    /// Decode a msgpack payload of an older schema version. Kinds without history refuse.
+    fn migrate(version: u32, _payload: &[u8]) -> Result<Self> {
+        Err(Error::NoMigration {
+            kind: Self::KIND.into(),
+            found: version,
+            supported: Self::SCHEMA_VERSION,
+        })
+    }
+}
+
+impl Artifact for Pattern {
+    const KIND: &'static str = "pattern";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), ValidationError> {
+        Pattern::validate(self)
+    }
+    fn summary(&self) -> String {
+        Pattern::summary(self)
+    }
+}
+
+impl Artifact for YarnModel {
+    const KIND: &'static str = "yarnmodel";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), ValidationError> {
+        YarnModel::validate(self)
+    }
+    fn summary(&self) -> String {
+        YarnModel::summary(self)
+    }
+    fn migrate(version: u32, payload: &[u8]) -> Result<Self> {
+        YarnModel::migrate(version, payload)
+    }
+}
+
+/// An artifact as a JSON document: its header and its payload (`yarnhom convert --to json`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct JsonDocument {
+    /// The container header.
+    pub header: Header,
+    /// The payload, in the schema version named by the header.
+    pub payload: serde_json::Value,
+}
+
+macro_rules! artifact_kinds {
+    ($($variant:ident => $ty:ty),+ $(,)?) => {
+        /// A decoded artifact of any kind.
+        #[derive(Debug, Clone, PartialEq)]
+        pub enum AnyArtifact {
+            $(
+                #[doc = concat!("A `", stringify!($ty), "`.")]
+                $variant($ty),
+            )+
+        }
+
+        /// Every artifact kind this build knows.
+        pub const KINDS: &[&str] = &[$(<$ty as Artifact>::KIND),+];
+
+        impl AnyArtifact {
+            /// Decode a verified container of any known kind (migrating older versions).
+            pub fn decode(raw: &RawArtifact) -> Result<Self> {
+                match raw.header.kind.as_str() {
+                    $(k if k == <$ty as Artifact>::KIND => Ok(Self::$variant(container::decode_payload(raw)?)),)+
+                    other => Err(Error::UnknownKind(other.to_string())),
+                }
+            }
+
+            /// The kind's name.
+            pub fn kind(&self) -> &'static str {
+                match self { $(Self::$variant(_) => <$ty as Artifact>::KIND,)+ }
+            }
+
+            /// A human summary.
+            pub fn summary(&self) -> String {
+                match self { $(Self::$variant(a) => a.summary(),)+ }
+            }
+
+            /// Validate and encode into container bytes.
+            pub fn encode(&self, provenance: &Provenance) -> Result<Vec<u8>> {
+                match self { $(Self::$variant(a) => container::encode(a, provenance),)+ }
+            }
+
+            /// The payload as JSON (current schema version).
+            pub fn to_json(&self) -> Result<serde_json::Value> {
+                let value = match self { $(Self::$variant(a) => serde_json::to_value(a),)+ };
+                value.map_err(|e| Error::Encode { what: "json", message: e.to_string() })
+            }
+        }
+
+        /// The JSON Schema of a kind's current version.
+        pub fn json_schema(kind: &str) -> Result<serde_json::Value> {
+            match kind {
+                $(k if k == <$ty as Artifact>::KIND => Ok(schema::of::<$ty>()),)+
+                other => Err(Error::UnknownKind(other.to_string())),
+            }
+        }
+
+        /// The current schema version of a kind.
+        pub fn schema_version(kind: &str) -> Result<u32> {
+            match kind {
+                $(k if k == <$ty as Artifact>::KIND => Ok(<$ty as Artifact>::SCHEMA_VERSION),)+
+                other => Err(Error::UnknownKind(other.to_string())),
+            }
+        }
+    };
+}
+
+artifact_kinds! {
+    Pattern => Pattern,
+    YarnModel => YarnModel,
+}
+
+impl AnyArtifact {
+    /// Read a `.yh` file of any kind; errors name the file.
+    pub fn read(path: impl AsRef<std::path::Path>) -> Result<(Header, Self)> {
+        let path = path.as_ref();
+        let bytes = std::fs::read(path).map_err(|e| Error::from(e).at(path))?;
+        let raw = container::decode_raw(&bytes).map_err(|e| e.at(path))?;
+        let value = Self::decode(&raw).map_err(|e| e.at(path))?;
+        Ok((raw.header, value))
+    }
+
+    /// Decode a [`JsonDocument`], migrating an older schema version like a `.yh` file would.
+    pub fn from_json_document(doc: &JsonDocument) -> Result<Self> {
+        let payload = rmp_serde::to_vec_named(&doc.payload).map_err(|e| Error::Encode {
+            what: "payload",
+            message: e.to_string(),
+        })?;
+        let header = Header {
+            content_hash: container::content_hash(&payload),
+            ..doc.header.clone()
+        };
+        Self::decode(&RawArtifact { header, payload })
+    }
+}
