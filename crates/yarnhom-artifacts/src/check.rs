@@ -51,7 +51,12 @@ pub fn len(field: &str, actual: usize, expected: usize, per: &str) -> Check {
     }
 }
 
-/// Flatten fixed-size rows for [`finite`].
-pub fn flat<const N: usize>(rows: &[[f64; N]]) -> impl Iterator<Item = &f64> {
-    rows.iter().flatten()
+/// Every entry of every row is finite; the error names row and column.
+pub fn finite_rows<const N: usize>(field: &str, rows: &[[f64; N]]) -> Check {
+    for (i, row) in rows.iter().enumerate() {
+        if let Some(j) = row.iter().position(|v| !v.is_finite()) {
+            return Err(ValidationError::new(format!("{field}[{i}][{j}]"), "not a finite number"));
+        }
+    }
+    Ok(())
 }

@@ -8,6 +8,7 @@
 //! - [`schema`]: JSON Schemas generated from the types.
 
 pub mod check;
+pub mod diff;
 pub mod container;
 pub mod error;
 #[cfg(feature = "hdf5")]

@@ -160,7 +160,7 @@ impl Pattern {
         check::positive("period_m[0]", self.period_m[0])?;
         check::positive("period_m[1]", self.period_m[1])?;
         let n = self.vertex_count();
-        check::finite("positions_m", check::flat(&self.positions_m))?;
+        check::finite_rows("positions_m", &self.positions_m)?;
         check::len("edge_twist_rad", self.edge_twist_rad.len(), n, "vertices")?;
         check::finite("edge_twist_rad", &self.edge_twist_rad)?;
         if self.yarns.is_empty() {
@@ -351,12 +351,9 @@ impl RestState {
         for (i, &l) in self.edge_length_m.iter().enumerate() {
             check::positive(&format!("rest.edge_length_m[{i}]"), l)?;
         }
-        check::finite("rest.vertex_curvature", check::flat(&self.vertex_curvature))?;
+        check::finite_rows("rest.vertex_curvature", &self.vertex_curvature)?;
         check::finite("rest.vertex_twist_rad", &self.vertex_twist_rad)?;
-        check::finite(
-            "rest.edge_reference_director",
-            check::flat(&self.edge_reference_director),
-        )?;
+        check::finite_rows("rest.edge_reference_director", &self.edge_reference_director)?;
         check::finite(
             "rest.vertex_reference_twist_rad",
             &self.vertex_reference_twist_rad,

@@ -1,1 +1,77 @@
-fn main() {}
+//! `yarnhom`: the command-line tool of the yarnhom yarn-level cloth toolchain.
+//!
+//! This crate only parses arguments, reports progress and errors, and wires the library
+//! crates together; it holds no numerics. Exit status: 0 success (and "equal" for `diff`),
+//! 1 "different" for `diff`, 2 any error (bad input, unreadable file, usage).
+
+mod convert;
+mod diff;
+mod inputs;
+mod inspect;
+mod model;
+mod pattern;
+mod schema;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// yarnhom: yarn-level cloth, from periodic yarn patterns to homogenized materials.
+///
+/// Every stage reads and writes versioned, schema-defined artifacts (`NAME.KIND.yh`: a
+/// checksummed, zstd-compressed msgpack container). `yarnhom inspect` tells what a file is,
+/// `yarnhom convert` turns it into JSON, HDF5 or `.pyp`, `yarnhom diff` compares two of them.
+#[derive(Debug, Parser)]
+#[command(name = "yarnhom", version, propagate_version = true, max_term_width = 100)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Periodic yarn patterns: list and run the built-in generators, import and export `.pyp`.
+    #[command(subcommand)]
+    Pattern(pattern::PatternCommand),
+    /// Yarn models: the built-in Table 4.1 parameter sets, written as `yarnmodel` artifacts.
+    #[command(subcommand)]
+    Model(model::ModelCommand),
+    /// Describe an artifact: kind, schema version, provenance and a human summary.
+    Inspect(inspect::InspectArgs),
+    /// Convert an artifact between `.yh`, JSON, HDF5 and `.pyp`.
+    Convert(convert::ConvertArgs),
+    /// Print the JSON Schema of an artifact kind, or write every schema to a folder.
+    Schema(schema::SchemaArgs),
+    /// Compare two artifacts of the same kind; exit 0 if equal within tolerance, 1 if different.
+    Diff(diff::DiffArgs),
+}
+
+/// What a command reports back to `main`.
+enum Outcome {
+    Success,
+    Different,
+}
+
+fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {
+        Command::Pattern(cmd) => pattern::run(cmd),
+        Command::Model(cmd) => model::run(cmd),
+        Command::Inspect(args) => inspect::run(args),
+        Command::Convert(args) => convert::run(args),
+        Command::Schema(args) => schema::run(args),
+        Command::Diff(args) => diff::run(args),
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(Outcome::Success) => ExitCode::SUCCESS,
+        Ok(Outcome::Different) => ExitCode::from(1),
+        Err(e) => {
+            let chain: Vec<String> = e.chain().map(ToString::to_string).collect();
+            eprintln!("error: {}", chain.join(": "));
+            ExitCode::from(2)
+        }
+    }
+}

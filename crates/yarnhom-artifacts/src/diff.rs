@@ -1,0 +1,193 @@
+//! Semantic differences between two artifacts of the same kind (`yarnhom diff`).
+//!
+//! Numbers are compared element-wise with `|a - b| <= atol + rtol * |b|` (numpy's `allclose`);
+//! structure (kind, yarn topology, array sizes, model family) must match exactly. A [`Diff`]
+//! lists every compared field with its largest and RMS difference, so a report says *where*
+//! two files differ, not only *whether*.
+
+use serde::Serialize;
+
+use crate::pattern::Pattern;
+use crate::yarnmodel::YarnModel;
+use crate::AnyArtifact;
+
+/// Tolerances of a comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Tolerance {
+    /// Relative tolerance.
+    pub rtol: f64,
+    /// Absolute tolerance (in the field's SI unit).
+    pub atol: f64,
+}
+
+impl Tolerance {
+    fn close(&self, a: f64, b: f64) -> bool {
+        (a - b).abs() <= self.atol + self.rtol * b.abs()
+    }
+}
+
+/// The comparison of one numeric field.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FieldDiff {
+    /// Field path, e.g. `positions_m`.
+    pub field: String,
+    /// Number of compared values.
+    pub count: usize,
+    /// Largest absolute difference.
+    pub max_abs: f64,
+    /// Root mean square of the differences.
+    pub rms: f64,
+    /// Index of the value (row) with the largest difference.
+    pub worst_index: usize,
+    /// Values outside the tolerance.
+    pub outside: usize,
+}
+
+/// The difference between two artifacts.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Diff {
+    /// Kind compared.
+    pub kind: String,
+    /// Structural differences (each makes the artifacts different, whatever the tolerance).
+    pub structural: Vec<String>,
+    /// Numeric fields compared.
+    pub fields: Vec<FieldDiff>,
+    /// Differences that do not count (names, origins).
+    pub notes: Vec<String>,
+}
+
+impl Diff {
+    /// Whether the two artifacts are equal within the tolerance.
+    pub fn equal(&self) -> bool {
+        self.structural.is_empty() && self.fields.iter().all(|f| f.outside == 0)
+    }
+
+    /// A human report, one line per finding.
+    pub fn report(&self) -> String {
+        let mut lines = vec![format!(
+            "{} {}",
+            self.kind,
+            if self.equal() { "equal within tolerance" } else { "DIFFERENT" }
+        )];
+        lines.extend(self.structural.iter().map(|s| format!("  structure: {s}")));
+        for f in &self.fields {
+            lines.push(format!(
+                "  {:<32} n={:<6} max|d|={:.3e} rms={:.3e} worst at [{}]{}",
+                f.field,
+                f.count,
+                f.max_abs,
+                f.rms,
+                f.worst_index,
+                if f.outside > 0 { format!("  {} outside tolerance", f.outside) } else { String::new() }
+            ));
+        }
+        lines.extend(self.notes.iter().map(|s| format!("  note: {s}")));
+        lines.join("\n")
+    }
+
+    fn new(kind: &str) -> Self {
+        Diff { kind: kind.into(), structural: vec![], fields: vec![], notes: vec![] }
+    }
+
+    /// Compare rows of numbers; a row's difference is the Euclidean norm of its element
+    /// differences, and a row is outside tolerance if any element is.
+    fn rows<const N: usize>(&mut self, field: &str, a: &[[f64; N]], b: &[[f64; N]], tol: Tolerance) {
+        if a.len() != b.len() {
+            self.structural.push(format!("{field}: {} vs {} entries", a.len(), b.len()));
+            return;
+        }
+        let mut d = FieldDiff { field: field.into(), count: a.len(), max_abs: 0.0, rms: 0.0, worst_index: 0, outside: 0 };
+        let mut sum_sq = 0.0;
+        for (i, (ra, rb)) in a.iter().zip(b).enumerate() {
+            let sq: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
+            sum_sq += sq;
+            let norm = sq.sqrt();
+            if norm > d.max_abs || norm.is_nan() {
+                d.max_abs = norm;
+                d.worst_index = i;
+            }
+            if !ra.iter().zip(rb).all(|(&x, &y)| tol.close(x, y)) {
+                d.outside += 1;
+            }
+        }
+        d.rms = if a.is_empty() { 0.0 } else { (sum_sq / a.len() as f64).sqrt() };
+        self.fields.push(d);
+    }
+
+    fn values(&mut self, field: &str, a: &[f64], b: &[f64], tol: Tolerance) {
+        let wrap = |v: &[f64]| v.iter().map(|&x| [x]).collect::<Vec<[f64; 1]>>();
+        self.rows(field, &wrap(a), &wrap(b), tol);
+    }
+}
+
+/// Compare two artifacts.
+pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
+    match (a, b) {
+        (AnyArtifact::Pattern(a), AnyArtifact::Pattern(b)) => diff_patterns(a, b, tol),
+        (AnyArtifact::YarnModel(a), AnyArtifact::YarnModel(b)) => diff_yarn_models(a, b, tol),
+        _ => {
+            let mut d = Diff::new(a.kind());
+            d.structural.push(format!("kinds differ: {} vs {}", a.kind(), b.kind()));
+            d
+        }
+    }
+}
+
+/// Compare two patterns: topology exactly, then periods, vertices, twists, radii, rest state.
+pub fn diff_patterns(a: &Pattern, b: &Pattern, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("pattern");
+    if a.name != b.name {
+        d.notes.push(format!("names differ: '{}' vs '{}'", a.name, b.name));
+    }
+    if a.fabric != b.fabric {
+        d.structural.push(format!("fabric: {} vs {}", a.fabric, b.fabric));
+    }
+    let topology = |p: &Pattern| -> Vec<(Vec<u32>, Vec<[i32; 2]>)> {
+        p.yarns.iter().map(|y| (y.vertices.clone(), y.edge_offsets.clone())).collect()
+    };
+    if a.yarns.len() != b.yarns.len() {
+        d.structural.push(format!("yarn count: {} vs {}", a.yarns.len(), b.yarns.len()));
+    } else if topology(a) != topology(b) {
+        d.structural.push("yarn connectivity (vertex order or edge offsets) differs".into());
+    }
+    d.values("period_m", &a.period_m, &b.period_m, tol);
+    d.rows("positions_m", &a.positions_m, &b.positions_m, tol);
+    d.values("edge_twist_rad", &a.edge_twist_rad, &b.edge_twist_rad, tol);
+    if a.yarns.len() == b.yarns.len() {
+        let radii = |p: &Pattern| p.yarns.iter().map(|y| y.radius_m).collect::<Vec<_>>();
+        d.values("yarns.radius_m", &radii(a), &radii(b), tol);
+    }
+    match (&a.rest, &b.rest) {
+        (Some(ra), Some(rb)) => {
+            d.values("rest.edge_length_m", &ra.edge_length_m, &rb.edge_length_m, tol);
+            d.rows("rest.vertex_curvature", &ra.vertex_curvature, &rb.vertex_curvature, tol);
+            d.values("rest.vertex_twist_rad", &ra.vertex_twist_rad, &rb.vertex_twist_rad, tol);
+            d.rows("rest.edge_reference_director", &ra.edge_reference_director, &rb.edge_reference_director, tol);
+            d.values("rest.vertex_reference_twist_rad", &ra.vertex_reference_twist_rad, &rb.vertex_reference_twist_rad, tol);
+        }
+        (None, None) => {}
+        (x, _) => d.structural.push(format!(
+            "rest state present only in the {} file",
+            if x.is_some() { "first" } else { "second" }
+        )),
+    }
+    d
+}
+
+/// Compare two yarn models parameter by parameter.
+pub fn diff_yarn_models(a: &YarnModel, b: &YarnModel, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("yarnmodel");
+    if a.name != b.name {
+        d.notes.push(format!("names differ: '{}' vs '{}'", a.name, b.name));
+    }
+    let (pa, pb) = (a.parameters(), b.parameters());
+    let names = |p: &[(&'static str, f64)]| p.iter().map(|x| x.0).collect::<Vec<_>>();
+    if names(&pa) != names(&pb) {
+        d.structural.push("model families differ".into());
+        return d;
+    }
+    for ((name, x), (_, y)) in pa.iter().zip(&pb) {
+        d.values(name, &[*x], &[*y], tol);
+    }
+    d
+}

@@ -1,0 +1,108 @@
+//! Proptest strategies for valid artifacts of every kind.
+#![allow(dead_code, missing_docs)]
+
+use proptest::prelude::*;
+use yarnhom_artifacts::{Fabric, Pattern, RestState, Yarn, YarnMechanics, YarnModel};
+
+fn finite(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
+    lo..hi
+}
+
+fn unit_vector() -> impl Strategy<Value = [f64; 3]> {
+    (0.0..std::f64::consts::PI, 0.0..std::f64::consts::TAU)
+        .prop_map(|(theta, phi): (f64, f64)| [theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()])
+}
+
+fn yarn_shapes() -> impl Strategy<Value = Vec<usize>> {
+    prop::collection::vec(3usize..9, 1..4)
+}
+
+/// A valid pattern: random positions inside the tile, periodic offsets whose sum is never zero.
+pub fn pattern() -> impl Strategy<Value = Pattern> {
+    (yarn_shapes(), finite(1e-3, 3e-2), finite(1e-3, 3e-2), finite(1e-5, 2e-3), any::<bool>(), any::<bool>())
+        .prop_flat_map(|(shape, px, py, radius, with_rest, knit)| {
+            let n: usize = shape.iter().sum();
+            let positions = prop::collection::vec(
+                (finite(-px / 2.0, px / 2.0), finite(-py / 2.0, py / 2.0), finite(-radius * 3.0, radius * 3.0))
+                    .prop_map(|(x, y, z)| [x, y, z]),
+                n,
+            );
+            let twists = prop::collection::vec(finite(-3.0, 3.0), n);
+            let offsets = prop::collection::vec((-1i32..=1, -1i32..=1).prop_map(|(a, b)| [a, b]), n);
+            let rest = rest_state(n);
+            (Just(shape), Just([px, py]), Just(radius), positions, twists, offsets, rest, Just(with_rest), Just(knit))
+        })
+        .prop_map(|(shape, period, radius, positions, twists, offsets, rest, with_rest, knit)| {
+            let mut yarns = Vec::new();
+            let mut start = 0;
+            for len in shape {
+                let mut edge_offsets = offsets[start..start + len].to_vec();
+                let sum = edge_offsets.iter().fold([0, 0], |a, o| [a[0] + o[0], a[1] + o[1]]);
+                if sum == [0, 0] {
+                    edge_offsets[len - 1][0] = if edge_offsets[len - 1][0] == 1 { 0 } else { edge_offsets[len - 1][0] + 1 };
+                }
+                yarns.push(Yarn {
+                    radius_m: radius,
+                    vertices: (start as u32..(start + len) as u32).collect(),
+                    edge_offsets,
+                });
+                start += len;
+            }
+            Pattern {
+                name: "random".into(),
+                fabric: if knit { Fabric::Knit } else { Fabric::Woven },
+                period_m: period,
+                // Shift vertex k by k * 1e-3 periods so that shrinking never makes edges vanish.
+                positions_m: positions
+                    .iter()
+                    .enumerate()
+                    .map(|(k, x)| [x[0] + k as f64 * 1e-3 * period[0], x[1], x[2]])
+                    .collect(),
+                edge_twist_rad: twists,
+                yarns,
+                rest: with_rest.then_some(rest),
+                origin: "proptest".into(),
+            }
+        })
+}
+
+fn rest_state(n: usize) -> impl Strategy<Value = RestState> {
+    (
+        prop::collection::vec(finite(1e-5, 1e-2), n),
+        prop::collection::vec((finite(-2.0, 2.0), finite(-2.0, 2.0)).prop_map(|(a, b)| [a, b]), n),
+        prop::collection::vec(finite(-1.0, 1.0), n),
+        prop::collection::vec(unit_vector(), n),
+        prop::collection::vec(finite(-1.0, 1.0), n),
+    )
+        .prop_map(|(l, k, t, d, rt)| RestState {
+            edge_length_m: l,
+            vertex_curvature: k,
+            vertex_twist_rad: t,
+            edge_reference_director: d,
+            vertex_reference_twist_rad: rt,
+        })
+}
+
+/// A valid yarn model of either family.
+pub fn yarn_model() -> impl Strategy<Value = YarnModel> {
+    let rod = (finite(1e3, 1e9), finite(1e3, 1e9), finite(1e-4, 10.0), finite(1e-1, 1e4)).prop_map(|(e, g, gamma, k)| {
+        YarnMechanics::ElasticRod { youngs_modulus_pa: e, shear_modulus_pa: g, gamma, contact_stiffness_kg_s2: k }
+    });
+    let biphasic = (finite(1e-3, 1.0), finite(1.0, 1e3), finite(0.0, 0.2), finite(1e-12, 1e-6), finite(1e-4, 1e-3), finite(1e-2, 1e2), finite(1e-2, 1e3))
+        .prop_map(|(f1, ks2, eps, kb, r1, kc1, kc2)| YarnMechanics::Biphasic {
+            k_s1_n: f1 * ks2,
+            k_s2_n: ks2,
+            eps_bar: eps,
+            k_b_nm2: kb,
+            r1_m: r1,
+            k_c1_n_m: kc1,
+            r2_m: 0.25 * r1,
+            k_c2_n_m: kc2,
+        });
+    (finite(1e-5, 1e-2), finite(10.0, 2e3), prop_oneof![rod, biphasic]).prop_map(|(r, rho, mechanics)| YarnModel {
+        name: "random".into(),
+        radius_m: r,
+        density_kg_m3: rho,
+        mechanics,
+    })
+}

@@ -1,0 +1,43 @@
+//! `yarnhom inspect FILE`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use crate::inputs;
+use crate::Outcome;
+
+#[derive(Debug, Args)]
+pub struct InspectArgs {
+    /// The file: a `.yh` artifact, a JSON document, an HDF5 export or a `.pyp` pattern.
+    pub input: PathBuf,
+    /// Print the header and payload as one JSON document instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: InspectArgs) -> anyhow::Result<Outcome> {
+    let loaded = inputs::load(&args.input, None)?;
+    if args.json {
+        let doc = yarnhom_artifacts::JsonDocument { header: loaded.header, payload: loaded.artifact.to_json()? };
+        println!("{}", serde_json::to_string_pretty(&doc)?);
+        return Ok(Outcome::Success);
+    }
+    let h = &loaded.header;
+    let current = yarnhom_artifacts::schema_version(&h.kind)?;
+    let migrated = if h.schema_version < current {
+        format!(" (read through migration to v{current})")
+    } else {
+        String::new()
+    };
+    println!("file: {} ({:?})", loaded.path.display(), loaded.format);
+    println!("kind: {} v{}{migrated}", h.kind, h.schema_version);
+    println!("producer: {} {}", h.producer.name, h.producer.version);
+    println!("created: {}", h.created_utc);
+    println!("content: {} ({} bytes)", h.content_hash, h.payload_bytes);
+    for input in &h.inputs {
+        println!("input: {} {} ({})", input.kind, input.content_hash, input.path);
+    }
+    println!("{}", loaded.artifact.summary());
+    Ok(Outcome::Success)
+}

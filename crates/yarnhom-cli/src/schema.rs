@@ -1,0 +1,33 @@
+//! `yarnhom schema KIND`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+use yarnhom_artifacts::{json_schema, schema, schema_version, KINDS};
+
+use crate::Outcome;
+
+#[derive(Debug, Args)]
+pub struct SchemaArgs {
+    /// Artifact kind (pattern, yarnmodel). Omit with --write-all.
+    #[arg(required_unless_present = "write_all")]
+    pub kind: Option<String>,
+    /// Write the current schema of every kind as DIR/<kind>.v<N>.schema.json (how the
+    /// committed `schemas/` folder is made).
+    #[arg(long, value_name = "DIR", conflicts_with = "kind")]
+    pub write_all: Option<PathBuf>,
+}
+
+pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
+    if let Some(dir) = args.write_all {
+        for kind in KINDS {
+            let path = dir.join(schema::file_name(kind, schema_version(kind)?));
+            let text = serde_json::to_string_pretty(&json_schema(kind)?)? + "\n";
+            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
+            eprintln!("wrote {}", path.display());
+        }
+    } else if let Some(kind) = args.kind {
+        println!("{}", serde_json::to_string_pretty(&json_schema(&kind)?)?);
+    }
+    Ok(Outcome::Success)
+}

@@ -1,0 +1,181 @@
+//! The `yarnhom` binary end to end: the acceptance commands of the foundation issue.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use yarnhom_artifacts::container::{self, Provenance};
+use yarnhom_artifacts::{Artifact, Pattern};
+
+const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-patterns");
+
+fn yarnhom(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_yarnhom")).args(args).current_dir(cwd).output().expect("run yarnhom")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn ok(args: &[&str], cwd: &Path) -> String {
+    let o = yarnhom(args, cwd);
+    assert!(o.status.success(), "yarnhom {args:?} failed: {}", stderr(&o));
+    stdout(&o)
+}
+
+/// Exit status 2 with a one-line `error: ...` naming `problem`, and no panic.
+fn fails_with(args: &[&str], cwd: &Path, problem: &str) {
+    let o = yarnhom(args, cwd);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "yarnhom {args:?}: {err}");
+    assert!(!err.contains("panicked"), "yarnhom {args:?} panicked: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.contains(problem), "yarnhom {args:?}: expected '{problem}' in: {err}");
+}
+
+fn rib(dir: &Path) -> PathBuf {
+    let out = dir.join("rib.pattern.yh");
+    ok(&["pattern", "import", &format!("{DATA}/rib.pyp"), "-o", out.to_str().expect("utf8")], dir);
+    out
+}
+
+#[test]
+fn import_and_inspect_show_the_published_rib() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = rib(dir.path());
+    let text = ok(&["inspect", out.to_str().expect("utf8")], dir.path());
+    // The published header: px py radius n = 0.0174261 0.0116613 0.001001 356.
+    for expected in ["kind: pattern v1", "17.4261 mm x 11.6613 mm", "vertices: 356", "yarn radius: 1.0010 mm", "knit fabric", "rest state: yes"] {
+        assert!(text.contains(expected), "missing '{expected}' in:\n{text}");
+    }
+    assert!(text.contains("input: pyp sha256:"), "provenance of the .pyp missing:\n{text}");
+}
+
+#[test]
+fn damaged_files_give_one_line_errors_and_exit_2() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = rib(dir.path());
+    let bytes = std::fs::read(&path).expect("read");
+    let write = |name: &str, b: &[u8]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, b).expect("write");
+        p.to_str().expect("utf8").to_string()
+    };
+    let truncated = write("truncated.pattern.yh", &bytes[..bytes.len() - 100]);
+    fails_with(&["inspect", &truncated], dir.path(), "truncated");
+    let mut flipped = bytes.clone();
+    flipped[bytes.len() / 2] ^= 0x10;
+    let flipped = write("flipped.pattern.yh", &flipped);
+    fails_with(&["inspect", &flipped], dir.path(), "checksum mismatch");
+    // A file from a future yarnhom: a correctly framed payload with a newer schema version.
+    let (_, pattern) = container::read::<Pattern>(&path).expect("read");
+    let payload = container::payload_of(&pattern).expect("payload");
+    let mut header = container::header_for::<Pattern>(&payload, &Provenance::default());
+    header.schema_version = Pattern::SCHEMA_VERSION + 1;
+    let bumped = write("bumped.pattern.yh", &container::frame(&header, &payload).expect("frame"));
+    fails_with(&["inspect", &bumped], dir.path(), "schema version 2 is newer than the supported version 1");
+    let mut newer_container = bytes.clone();
+    newer_container[8] += 1;
+    let newer_container = write("container.pattern.yh", &newer_container);
+    fails_with(&["inspect", &newer_container], dir.path(), "container version 2 is newer");
+    let garbage = write("garbage.pattern.yh", b"\x89YHOM\r\n\x1a\x01\x00\xff\xff\xff\xff");
+    fails_with(&["diff", &garbage, &truncated], dir.path(), "truncated");
+    fails_with(&["inspect", "does-not-exist.yh"], dir.path(), "does-not-exist.yh");
+    let text = write("notes.txt", b"hello");
+    fails_with(&["convert", &text, "--to", "json"], dir.path(), "not a yarnhom artifact");
+}
+
+#[test]
+fn diff_exits_0_for_equal_and_1_for_different_patterns() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = rib(dir.path());
+    let a = a.to_str().expect("utf8");
+    assert_eq!(yarnhom(&["diff", a, a], dir.path()).status.code(), Some(0));
+    let b = dir.path().join("stock.pattern.yh");
+    ok(&["pattern", "import", &format!("{DATA}/stock.pyp"), "-o", b.to_str().expect("utf8")], dir.path());
+    let o = yarnhom(&["diff", a, b.to_str().expect("utf8")], dir.path());
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stdout(&o).contains("DIFFERENT"));
+    // Moving one vertex by 1 um: different at the default tolerance, equal with atol = 2 um.
+    let (_, mut moved) = container::read::<Pattern>(a).expect("read");
+    moved.positions_m[7][2] += 1e-6;
+    let c = dir.path().join("moved.pattern.yh");
+    container::write(&c, &moved, &Provenance::default()).expect("write");
+    let c = c.to_str().expect("utf8");
+    let o = yarnhom(&["diff", a, c], dir.path());
+    assert_eq!(o.status.code(), Some(1));
+    assert!(stdout(&o).contains("worst at [7]"), "{}", stdout(&o));
+    assert_eq!(yarnhom(&["diff", a, c, "--atol", "2e-6"], dir.path()).status.code(), Some(0));
+    fails_with(&["diff", a, c, "--rtol", "-1"], dir.path(), "tolerances must be non-negative");
+}
+
+#[test]
+fn conversions_are_lossless() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let a = rib(dir.path());
+    let a = a.to_str().expect("utf8");
+    for (format, file) in [("json", "rib.pattern.json"), ("hdf5", "rib.pattern.h5"), ("pyp", "rib.pyp")] {
+        let out = dir.path().join(file);
+        ok(&["convert", a, "--to", format, "-o", out.to_str().expect("utf8")], dir.path());
+        let back = dir.path().join(format!("back-{format}.pattern.yh"));
+        ok(&["convert", out.to_str().expect("utf8"), "--to", "yh", "-o", back.to_str().expect("utf8")], dir.path());
+        let o = yarnhom(&["diff", a, back.to_str().expect("utf8"), "--rtol", "0"], dir.path());
+        assert_eq!(o.status.code(), Some(0), "{format}: {}", stdout(&o));
+    }
+    fails_with(&["convert", a, "--to", "yh", "-o", a], dir.path(), "would overwrite the input");
+}
+
+#[test]
+fn every_generator_writes_a_valid_pattern() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let list = ok(&["pattern", "list"], dir.path());
+    for name in ["stockinette", "garter", "rib", "seed", "plain", "basket", "satin"] {
+        assert!(list.contains(name), "{name} not listed");
+        let out = dir.path().join(format!("{name}.pattern.yh"));
+        ok(&["pattern", "generate", name, "-o", out.to_str().expect("utf8")], dir.path());
+        let (_, p) = container::read::<Pattern>(&out).expect("a generated pattern reads back");
+        assert_eq!(p.name, name);
+    }
+    fails_with(&["pattern", "generate", "argyle"], dir.path(), "argyle");
+    fails_with(&["pattern", "generate", "rib", "--radius-m", "-0.001"], dir.path(), "radius");
+}
+
+#[test]
+fn yarn_models_and_schemas() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let list = ok(&["model", "list"], dir.path());
+    assert_eq!(list.lines().count(), 7, "Table 4.1 has seven rows:\n{list}");
+    let out = dir.path().join("rib.yarnmodel.yh");
+    ok(&["model", "write", "table4.1:rib", "-o", out.to_str().expect("utf8")], dir.path());
+    let text = ok(&["inspect", out.to_str().expect("utf8")], dir.path());
+    assert!(text.contains("youngs_modulus_pa = 500000"), "{text}");
+    fails_with(&["model", "write", "table4.1:argyle"], dir.path(), "unknown yarn model");
+    let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/yarnmodel.v0.yh");
+    assert!(ok(&["inspect", fixture], dir.path()).contains("read through migration to v1"));
+    for kind in yarnhom_artifacts::KINDS {
+        let schema: serde_json::Value = serde_json::from_str(&ok(&["schema", kind], dir.path())).expect("JSON");
+        assert_eq!(schema["$id"], format!("yarnhom:{kind}.v1"));
+    }
+    fails_with(&["schema", "teapot"], dir.path(), "unknown artifact kind 'teapot'");
+    fails_with(&["convert", out.to_str().expect("utf8"), "--to", "pyp"], dir.path(), "only patterns");
+}
+
+#[test]
+fn every_command_explains_itself() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let commands: &[&[&str]] = &[
+        &[], &["pattern"], &["pattern", "list"], &["pattern", "generate"], &["pattern", "import"],
+        &["pattern", "export"], &["model"], &["model", "list"], &["model", "write"], &["inspect"],
+        &["convert"], &["schema"], &["diff"],
+    ];
+    for cmd in commands {
+        let mut args = cmd.to_vec();
+        args.push("--help");
+        let text = ok(&args, dir.path());
+        assert!(text.contains("Usage:"), "{cmd:?} --help:\n{text}");
+        assert!(text.lines().next().is_some_and(|l| l.len() > 20), "{cmd:?} has no description:\n{text}");
+    }
+}

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# The README's main command: yarnhom's pipeline on built-in defaults, printing where each
+# artifact went. Today it covers the foundation stage: published and generated patterns, the
+# Table 4.1 yarn models, inspection, conversion (JSON, HDF5, .pyp) and semantic diff. Later
+# stages (relax -> sample -> fit -> simulate) join it as they land.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/setup.sh
+out="${1:-demo-out}"
+data="../shared/data/hylc-patterns"
+mkdir -p "$out"
+cargo build --quiet -p yarnhom-cli
+yarnhom() { cargo run --quiet -p yarnhom-cli -- "$@"; }
+
+echo "== published rib pattern (HYLC) -> $out/rib.pattern.yh"
+yarnhom pattern import "$data/rib.pyp" -o "$out/rib.pattern.yh"
+yarnhom inspect "$out/rib.pattern.yh"
+
+echo "== built-in generators -> $out/<name>.pattern.yh"
+yarnhom pattern list
+for name in stockinette garter rib seed plain basket satin; do
+  yarnhom pattern generate "$name" -o "$out/gen-$name.pattern.yh"
+done
+
+echo "== yarn models of Table 4.1 -> $out/<row>.yarnmodel.yh"
+yarnhom model write table4.1:rib -o "$out/rib.yarnmodel.yh"
+yarnhom inspect "$out/rib.yarnmodel.yh"
+
+echo "== conversions of the rib pattern"
+yarnhom convert "$out/rib.pattern.yh" --to json -o "$out/rib.pattern.json"
+yarnhom convert "$out/rib.pattern.yh" --to hdf5 -o "$out/rib.pattern.h5"
+yarnhom convert "$out/rib.pattern.yh" --to pyp -o "$out/rib.pyp"
+
+echo "== semantic diff: the HDF5 export against the original (equal), stockinette against rib (different)"
+yarnhom diff "$out/rib.pattern.yh" "$out/rib.pattern.h5"
+if yarnhom diff "$out/gen-stockinette.pattern.yh" "$out/gen-rib.pattern.yh" >/dev/null; then
+  echo "unexpected: different patterns compared equal" >&2
+  exit 1
+fi
+echo "== done: artifacts in $out/"
