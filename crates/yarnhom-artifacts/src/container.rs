@@ -351,8 +351,19 @@ pub fn write<T: Artifact>(
     Ok(header)
 }
 
-/// Write bytes to `path` atomically: a temporary file beside it, flushed and synced, then renamed.
+/// Write bytes to `path` atomically (see [`replace_atomically`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    replace_atomically(path, |_, file| Ok(file.write_all(bytes)?))
+}
+
+/// Replace `path` atomically with what `fill` writes into a temporary file beside it (given both
+/// as a path, for libraries that open files by name, and as an open file): the temporary file is
+/// synced, given the permissions of the file it replaces (or `0644`), then renamed over `path`.
+/// A reader never sees a half-written file; on error `path` is untouched and nothing is left.
+pub fn replace_atomically(
+    path: &Path,
+    fill: impl FnOnce(&Path, &mut std::fs::File) -> Result<()>,
+) -> Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -361,8 +372,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .prefix(".yarnhom-")
         .suffix(".tmp")
         .tempfile_in(dir)?;
-    tmp.write_all(bytes)?;
+    let tmp_path = tmp.path().to_path_buf();
+    fill(&tmp_path, tmp.as_file_mut())?;
     tmp.as_file().sync_all()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path).map_or(0o644, |m| m.permissions().mode());
+        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(mode))?;
+    }
     tmp.persist(path).map_err(|e| Error::Io(e.error))?;
     Ok(())
 }

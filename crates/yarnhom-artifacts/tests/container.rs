@@ -222,3 +222,17 @@ proptest! {
         let _ = decode::<Pattern>(&bytes);
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn written_files_are_world_readable_and_keep_the_permissions_they_replace() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("x.pattern.yh");
+    let mode = |p: &std::path::Path| std::fs::metadata(p).expect("stat").permissions().mode() & 0o777;
+    container::write(&path, &sample_pattern(), &Provenance::default()).expect("write");
+    assert_eq!(mode(&path), 0o644);
+    std::fs::set_permissions(&path, std::fs::Permissions::from_mode(0o600)).expect("chmod");
+    container::write(&path, &sample_pattern(), &Provenance::default()).expect("overwrite");
+    assert_eq!(mode(&path), 0o600);
+}
