@@ -36,6 +36,9 @@ fn err(line: usize, message: impl Into<String>) -> Error {
     }
 }
 
+/// Numeric rows of a section, each with its 1-based line number.
+type Rows = [(usize, Vec<f64>)];
+
 /// One `*section` with its numeric rows and their line numbers.
 struct Section {
     name: String,
@@ -83,7 +86,7 @@ fn table<'a>(
     name: &str,
     rows: usize,
     cols: usize,
-) -> Result<Option<&'a [(usize, Vec<f64>)]>> {
+) -> Result<Option<&'a Rows>> {
     let Some(s) = all.iter().find(|s| s.name == name) else {
         return Ok(None);
     };
@@ -107,7 +110,7 @@ fn required<'a>(
     name: &str,
     rows: usize,
     cols: usize,
-) -> Result<&'a [(usize, Vec<f64>)]> {
+) -> Result<&'a Rows> {
     table(all, name, rows, cols)?.ok_or_else(|| err(0, format!("missing section *{name}")))
 }
 
@@ -159,7 +162,7 @@ pub fn parse_pyp(text: &str, name: &str, fabric: Option<Fabric>) -> Result<Patte
 
 /// Follow the `*E` rows into yarns: every vertex must have exactly one outgoing and one
 /// incoming edge. Yarns start at their lowest-numbered vertex.
-fn yarns_from_edges(rows: &[(usize, Vec<f64>)], n: usize, radius: f64) -> Result<Vec<Yarn>> {
+fn yarns_from_edges(rows: &Rows, n: usize, radius: f64) -> Result<Vec<Yarn>> {
     let mut next: Vec<Option<(u32, [i32; 2], usize)>> = vec![None; n];
     let mut incoming: Vec<Option<usize>> = vec![None; n];
     for (line, r) in rows {
