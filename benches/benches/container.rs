@@ -2,10 +2,10 @@
 //! on the published HYLC rib tile (356 vertices with rest state).
 //! Compared with: parsing the same tile from its published `.pyp` text.
 
-use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use yarnhom_artifacts::container::{decode, encode, Provenance};
-use yarnhom_artifacts::pyp::{parse_pyp, write_pyp};
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use yarnhom_artifacts::Pattern;
+use yarnhom_artifacts::container::{Provenance, decode, encode};
+use yarnhom_artifacts::pyp::{parse_pyp, write_pyp};
 
 const RIB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/hylc-patterns/rib.pyp");
 
@@ -24,7 +24,9 @@ fn bench_container(c: &mut Criterion) {
     g.bench_function("yh decode (checksum, zstd, msgpack, validate)", |b| {
         b.iter(|| decode::<Pattern>(std::hint::black_box(&bytes)).expect("decode"))
     });
-    g.bench_function("yh encode", |b| b.iter(|| encode(std::hint::black_box(&pattern), &Provenance::default()).expect("encode")));
+    g.bench_function("yh encode", |b| {
+        b.iter(|| encode(std::hint::black_box(&pattern), &Provenance::default()).expect("encode"))
+    });
     g.bench_function("pyp parse (published format)", |b| {
         b.iter(|| parse_pyp(std::hint::black_box(&text), "rib", None).expect("parse"))
     });

@@ -3,7 +3,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use yarnhom_artifacts::{container, AnyArtifact};
+use yarnhom_artifacts::{AnyArtifact, container};
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(raw) = container::decode_raw(data) {

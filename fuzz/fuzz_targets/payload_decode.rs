@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use yarnhom_artifacts::container::{content_hash, Header, Producer, RawArtifact};
+use yarnhom_artifacts::container::{Header, Producer, RawArtifact, content_hash};
 use yarnhom_artifacts::{AnyArtifact, KINDS};
 
 fuzz_target!(|data: &[u8]| {

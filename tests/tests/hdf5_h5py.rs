@@ -9,10 +9,7 @@ use std::process::Command;
 use yarnhom_artifacts::container::{self, InputRef, Provenance};
 use yarnhom_artifacts::{AnyArtifact, Header, Pattern, hdf5, pyp};
 
-const PATTERNS: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/../../shared/data/hylc-patterns"
-);
+const PATTERNS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/hylc-patterns");
 const TOOL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tools/h5py_read_pattern.py");
 
 /// Every published pattern, parsed, with the header an import would give it.
@@ -23,18 +20,15 @@ fn published() -> Vec<(String, Header, Pattern)> {
         .filter(|p| p.extension().is_some_and(|x| x == "pyp"))
         .collect();
     files.sort();
-    assert!(
-        files.len() >= 6,
-        "expected the 6 published patterns in {PATTERNS}"
-    );
+    assert!(files.len() >= 6, "expected the 6 published patterns in {PATTERNS}");
     files
         .iter()
         .map(|path| {
             let name = path.file_stem().unwrap().to_string_lossy().into_owned();
             let bytes = std::fs::read(path).unwrap();
             let text = String::from_utf8(bytes.clone()).unwrap();
-            let pattern = pyp::parse_pyp(&text, &name, None)
-                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let pattern =
+                pyp::parse_pyp(&text, &name, None).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
             let provenance = Provenance {
                 inputs: vec![InputRef {
                     kind: "pyp".into(),
@@ -54,13 +48,7 @@ fn published() -> Vec<(String, Header, Pattern)> {
 fn variants(pattern: &Pattern) -> Vec<(&'static str, Pattern)> {
     let mut out = vec![("as published", pattern.clone())];
     if pattern.rest.is_some() {
-        out.push((
-            "without rest state",
-            Pattern {
-                rest: None,
-                ..pattern.clone()
-            },
-        ));
+        out.push(("without rest state", Pattern { rest: None, ..pattern.clone() }));
     }
     out
 }
@@ -80,9 +68,7 @@ fn published_patterns_round_trip_exactly() {
             let file = format!("{name}-{}.h5", p.rest.is_some());
             let path = export(dir.path(), &file, &header, &p);
             let (h, back) = hdf5::import(&path).unwrap_or_else(|e| panic!("import {file}: {e}"));
-            let AnyArtifact::Pattern(back) = back else {
-                panic!("{file}: imported a {}", back.kind())
-            };
+            let AnyArtifact::Pattern(back) = back else { panic!("{file}: imported a {}", back.kind()) };
             assert_eq!(back, p, "{name} ({variant})");
             // msgpack stores every f64 bit for bit: equal payloads mean bit-identical floats
             // (-0.0 included), which `==` on f64 does not check.
@@ -91,10 +77,7 @@ fn published_patterns_round_trip_exactly() {
                 container::payload_of(&p).unwrap(),
                 "{name} ({variant}): not bit-identical"
             );
-            assert_eq!(
-                h.content_hash,
-                container::content_hash(&container::payload_of(&p).unwrap())
-            );
+            assert_eq!(h.content_hash, container::content_hash(&container::payload_of(&p).unwrap()));
             assert_eq!(
                 (&h.producer, &h.created_utc, &h.inputs),
                 (&header.producer, &header.created_utc, &header.inputs),
@@ -109,19 +92,13 @@ fn published_patterns_round_trip_exactly() {
 
 /// Make h5py importable (one `pip install` attempt); `Err(reason)` when it cannot be.
 fn h5py_available() -> Result<(), String> {
-    let probe = || {
-        Command::new("python3")
-            .args(["-c", "import h5py, numpy"])
-            .output()
-    };
+    let probe = || Command::new("python3").args(["-c", "import h5py, numpy"]).output();
     match probe() {
         Ok(out) if out.status.success() => return Ok(()),
         Ok(_) => {}
         Err(e) => return Err(format!("cannot run python3: {e}")),
     }
-    let install = Command::new("python3")
-        .args(["-m", "pip", "install", "--quiet", "h5py", "numpy"])
-        .output();
+    let install = Command::new("python3").args(["-m", "pip", "install", "--quiet", "h5py", "numpy"]).output();
     match probe() {
         Ok(out) if out.status.success() => Ok(()),
         Ok(out) => Err(format!(
@@ -138,11 +115,7 @@ fn h5py_available() -> Result<(), String> {
 
 /// Run the h5py reader; its JSON summary, or its exit status and message.
 fn h5py_read(path: &Path) -> Result<serde_json::Value, String> {
-    let out = Command::new("python3")
-        .arg(TOOL)
-        .arg(path)
-        .output()
-        .unwrap();
+    let out = Command::new("python3").arg(TOOL).arg(path).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr).trim().to_string();
     if !out.status.success() {
         return Err(format!("exit {:?}: {stderr}", out.status.code()));
@@ -158,11 +131,7 @@ fn close(a: f64, b: f64) -> bool {
 }
 
 fn floats(v: &serde_json::Value) -> Vec<f64> {
-    v.as_array()
-        .unwrap_or_else(|| panic!("not an array: {v}"))
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
+    v.as_array().unwrap_or_else(|| panic!("not an array: {v}")).iter().map(|x| x.as_f64().unwrap()).collect()
 }
 
 #[test]
@@ -184,19 +153,10 @@ fn h5py_reads_published_patterns() {
             assert_eq!(summary["has_rest"], p.rest.is_some(), "{what}");
             let period = floats(&summary["period_m"]);
             assert_eq!(period.len(), 2, "{what}");
-            assert!(
-                period.iter().zip(&p.period_m).all(|(&a, &b)| close(a, b)),
-                "{what}"
-            );
+            assert!(period.iter().zip(&p.period_m).all(|(&a, &b)| close(a, b)), "{what}");
             let radius = floats(&summary["radius_m"]);
             assert_eq!(radius.len(), p.yarns.len(), "{what}");
-            assert!(
-                radius
-                    .iter()
-                    .zip(&p.yarns)
-                    .all(|(&a, y)| close(a, y.radius_m)),
-                "{what}"
-            );
+            assert!(radius.iter().zip(&p.yarns).all(|(&a, y)| close(a, y.radius_m)), "{what}");
         }
     }
 }
@@ -216,11 +176,7 @@ fn h5py_and_importer_refuse_a_corrupted_export() {
     let script = "import sys, h5py\n\
                   with h5py.File(sys.argv[1], 'r+') as f:\n    \
                   v = f['yarns/vertices']\n    v[0] = v[1]\n";
-    let status = Command::new("python3")
-        .args(["-c", script])
-        .arg(&path)
-        .status()
-        .unwrap();
+    let status = Command::new("python3").args(["-c", script]).arg(&path).status().unwrap();
     assert!(status.success());
     let e = h5py_read(&path).unwrap_err();
     assert!(e.contains("used 2 times"), "{e}");

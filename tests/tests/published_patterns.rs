@@ -73,7 +73,8 @@ fn export_reproduces_every_number_of_the_published_files() {
             if sa == "E" {
                 // Edge rows carry no order; compare them as a set.
                 let sorted = |r: &Vec<Vec<f64>>| {
-                    let mut v: Vec<Vec<i64>> = r.iter().map(|x| x.iter().map(|&f| f as i64).collect()).collect();
+                    let mut v: Vec<Vec<i64>> =
+                        r.iter().map(|x| x.iter().map(|&f| f as i64).collect()).collect();
                     v.sort();
                     v
                 };

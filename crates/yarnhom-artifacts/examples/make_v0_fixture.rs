@@ -3,11 +3,19 @@
 //! keeps loading through the migration. Run once from the repository root:
 //! `cargo run -p yarnhom-artifacts --example make_v0_fixture`.
 
-use yarnhom_artifacts::container::{content_hash, frame, payload_of, Header, Producer};
+use yarnhom_artifacts::container::{Header, Producer, content_hash, frame, payload_of};
 use yarnhom_artifacts::yarnmodel::YarnModelV0;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let v0 = YarnModelV0 { name: "table4.1:rib".into(), e: 5e5, g: 2e5, gamma: 0.001, k_contact: 6e1, rho: 6e1, radius: 1e-3 };
+    let v0 = YarnModelV0 {
+        name: "table4.1:rib".into(),
+        e: 5e5,
+        g: 2e5,
+        gamma: 0.001,
+        k_contact: 6e1,
+        rho: 6e1,
+        radius: 1e-3,
+    };
     let payload = payload_of(&v0)?;
     let header = Header {
         kind: "yarnmodel".into(),

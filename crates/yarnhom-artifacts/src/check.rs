@@ -7,10 +7,7 @@ type Check = Result<(), ValidationError>;
 /// Every value is finite (no NaN, no infinity).
 pub fn finite<'a>(field: &str, values: impl IntoIterator<Item = &'a f64>) -> Check {
     match values.into_iter().position(|v| !v.is_finite()) {
-        Some(i) => Err(ValidationError::new(
-            format!("{field}[{i}]"),
-            "not a finite number",
-        )),
+        Some(i) => Err(ValidationError::new(format!("{field}[{i}]"), "not a finite number")),
         None => Ok(()),
     }
 }
@@ -20,10 +17,7 @@ pub fn positive(field: &str, value: f64) -> Check {
     if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ValidationError::new(
-            field,
-            format!("must be a finite number > 0, got {value}"),
-        ))
+        Err(ValidationError::new(field, format!("must be a finite number > 0, got {value}")))
     }
 }
 
@@ -32,10 +26,7 @@ pub fn non_negative(field: &str, value: f64) -> Check {
     if value.is_finite() && value >= 0.0 {
         Ok(())
     } else {
-        Err(ValidationError::new(
-            field,
-            format!("must be a finite number >= 0, got {value}"),
-        ))
+        Err(ValidationError::new(field, format!("must be a finite number >= 0, got {value}")))
     }
 }
 
@@ -44,10 +35,7 @@ pub fn len(field: &str, actual: usize, expected: usize, per: &str) -> Check {
     if actual == expected {
         Ok(())
     } else {
-        Err(ValidationError::new(
-            field,
-            format!("has {actual} entries but there are {expected} {per}"),
-        ))
+        Err(ValidationError::new(field, format!("has {actual} entries but there are {expected} {per}")))
     }
 }
 

@@ -47,10 +47,7 @@ pub struct Producer {
 
 impl Default for Producer {
     fn default() -> Self {
-        Self {
-            name: "yarnhom".into(),
-            version: env!("CARGO_PKG_VERSION").into(),
-        }
+        Self { name: "yarnhom".into(), version: env!("CARGO_PKG_VERSION").into() }
     }
 }
 
@@ -117,10 +114,7 @@ fn now_rfc3339() -> String {
 
 /// Encode a value's payload: msgpack with named fields.
 pub fn payload_of<T: Serialize>(value: &T) -> Result<Vec<u8>> {
-    rmp_serde::to_vec_named(value).map_err(|e| Error::Encode {
-        what: "payload",
-        message: e.to_string(),
-    })
+    rmp_serde::to_vec_named(value).map_err(|e| Error::Encode { what: "payload", message: e.to_string() })
 }
 
 /// The header a fresh artifact of kind `T` with this payload gets.
@@ -138,10 +132,7 @@ pub fn header_for<T: Artifact>(payload: &[u8], provenance: &Provenance) -> Heade
 
 /// Validate and encode an artifact into container bytes.
 pub fn encode<T: Artifact>(value: &T, provenance: &Provenance) -> Result<Vec<u8>> {
-    value.validate().map_err(|source| Error::Invalid {
-        kind: T::KIND,
-        source,
-    })?;
+    value.validate().map_err(|source| Error::Invalid { kind: T::KIND, source })?;
     let payload = payload_of(value)?;
     frame(&header_for::<T>(&payload, provenance), &payload)
 }
@@ -149,18 +140,12 @@ pub fn encode<T: Artifact>(value: &T, provenance: &Provenance) -> Result<Vec<u8>
 /// Frame an already encoded msgpack payload under `header` (low level: the header is trusted as
 /// given, so this also writes files of older or newer schema versions, e.g. test fixtures).
 pub fn frame(header: &Header, payload: &[u8]) -> Result<Vec<u8>> {
-    let header_bytes = rmp_serde::to_vec_named(header).map_err(|e| Error::Encode {
-        what: "header",
-        message: e.to_string(),
-    })?;
-    let compressed = zstd::bulk::compress(payload, ZSTD_LEVEL).map_err(|e| Error::Encode {
-        what: "zstd payload",
-        message: e.to_string(),
-    })?;
-    let header_len = u32::try_from(header_bytes.len()).map_err(|_| Error::Encode {
-        what: "header",
-        message: "longer than 4 GiB".into(),
-    })?;
+    let header_bytes = rmp_serde::to_vec_named(header)
+        .map_err(|e| Error::Encode { what: "header", message: e.to_string() })?;
+    let compressed = zstd::bulk::compress(payload, ZSTD_LEVEL)
+        .map_err(|e| Error::Encode { what: "zstd payload", message: e.to_string() })?;
+    let header_len = u32::try_from(header_bytes.len())
+        .map_err(|_| Error::Encode { what: "header", message: "longer than 4 GiB".into() })?;
     let mut out = Vec::with_capacity(FIXED_PREFIX + header_bytes.len() + 8 + compressed.len() + 4);
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&CONTAINER_VERSION.to_le_bytes());
@@ -183,11 +168,7 @@ impl<'a> Sections<'a> {
     fn take(&mut self, section: &'static str, n: u64) -> Result<&'a [u8]> {
         let available = (self.bytes.len() - self.at) as u64;
         if n > available {
-            return Err(Error::Truncated {
-                section,
-                needed: n,
-                available,
-            });
+            return Err(Error::Truncated { section, needed: n, available });
         }
         let n = n as usize;
         let out = &self.bytes[self.at..self.at + n];
@@ -214,20 +195,14 @@ pub struct RawArtifact {
 /// Read only the header, after checking framing and checksum (cheap: no decompression).
 pub fn decode_header(bytes: &[u8]) -> Result<(Header, &[u8])> {
     let mut s = Sections { bytes, at: 0 };
-    let magic = s.take("magic", 8).map_err(|_| Error::WrongMagic {
-        found: bytes[..bytes.len().min(8)].to_vec(),
-    })?;
+    let magic =
+        s.take("magic", 8).map_err(|_| Error::WrongMagic { found: bytes[..bytes.len().min(8)].to_vec() })?;
     if magic != MAGIC {
-        return Err(Error::WrongMagic {
-            found: magic.to_vec(),
-        });
+        return Err(Error::WrongMagic { found: magic.to_vec() });
     }
     let version = u16::from_le_bytes(s.array("container version")?);
     if version > CONTAINER_VERSION {
-        return Err(Error::NewerContainer {
-            found: version,
-            supported: CONTAINER_VERSION,
-        });
+        return Err(Error::NewerContainer { found: version, supported: CONTAINER_VERSION });
     }
     let header_len = u32::from_le_bytes(s.array("header length")?);
     let header_bytes = s.take("header", u64::from(header_len))?;
@@ -236,18 +211,14 @@ pub fn decode_header(bytes: &[u8]) -> Result<(Header, &[u8])> {
     let crc_end = s.at;
     let stored = u32::from_le_bytes(s.array("checksum")?);
     if s.at != bytes.len() {
-        return Err(Error::TrailingBytes {
-            extra: (bytes.len() - s.at) as u64,
-        });
+        return Err(Error::TrailingBytes { extra: (bytes.len() - s.at) as u64 });
     }
     let computed = crc32fast::hash(&bytes[..crc_end]);
     if stored != computed {
         return Err(Error::ChecksumMismatch { stored, computed });
     }
-    let header: Header = rmp_serde::from_slice(header_bytes).map_err(|e| Error::Decode {
-        what: "header",
-        message: e.to_string(),
-    })?;
+    let header: Header = rmp_serde::from_slice(header_bytes)
+        .map_err(|e| Error::Decode { what: "header", message: e.to_string() })?;
     Ok((header, compressed))
 }
 
@@ -263,30 +234,18 @@ pub fn decode_raw(bytes: &[u8]) -> Result<RawArtifact> {
     let payload = decompress(compressed, header.payload_bytes)?;
     let computed = content_hash(&payload);
     if computed != header.content_hash {
-        return Err(Error::ContentHashMismatch {
-            stored: header.content_hash,
-            computed,
-        });
+        return Err(Error::ContentHashMismatch { stored: header.content_hash, computed });
     }
     Ok(RawArtifact { header, payload })
 }
 
 fn decompress(compressed: &[u8], expected: u64) -> Result<Vec<u8>> {
-    let err = |message: String| Error::Decode {
-        what: "zstd payload",
-        message,
-    };
+    let err = |message: String| Error::Decode { what: "zstd payload", message };
     let decoder = zstd::stream::read::Decoder::new(compressed).map_err(|e| err(e.to_string()))?;
     let mut out = Vec::with_capacity(expected.min(1 << 26) as usize);
-    decoder
-        .take(expected + 1)
-        .read_to_end(&mut out)
-        .map_err(|e| err(e.to_string()))?;
+    decoder.take(expected + 1).read_to_end(&mut out).map_err(|e| err(e.to_string()))?;
     if out.len() as u64 != expected {
-        return Err(err(format!(
-            "decompressed to {} bytes, header says {expected}",
-            out.len()
-        )));
+        return Err(err(format!("decompressed to {} bytes, header says {expected}", out.len())));
     }
     Ok(out)
 }
@@ -295,10 +254,7 @@ fn decompress(compressed: &[u8], expected: u64) -> Result<Vec<u8>> {
 pub fn decode_payload<T: Artifact>(raw: &RawArtifact) -> Result<T> {
     let h = &raw.header;
     if h.kind != T::KIND {
-        return Err(Error::WrongKind {
-            expected: T::KIND,
-            found: h.kind.clone(),
-        });
+        return Err(Error::WrongKind { expected: T::KIND, found: h.kind.clone() });
     }
     let value = match h.schema_version.cmp(&T::SCHEMA_VERSION) {
         std::cmp::Ordering::Greater => {
@@ -308,18 +264,11 @@ pub fn decode_payload<T: Artifact>(raw: &RawArtifact) -> Result<T> {
                 supported: T::SCHEMA_VERSION,
             });
         }
-        std::cmp::Ordering::Equal => {
-            rmp_serde::from_slice(&raw.payload).map_err(|e| Error::Decode {
-                what: T::KIND,
-                message: e.to_string(),
-            })?
-        }
+        std::cmp::Ordering::Equal => rmp_serde::from_slice(&raw.payload)
+            .map_err(|e| Error::Decode { what: T::KIND, message: e.to_string() })?,
         std::cmp::Ordering::Less => T::migrate(h.schema_version, &raw.payload)?,
     };
-    value.validate().map_err(|source| Error::Invalid {
-        kind: T::KIND,
-        source,
-    })?;
+    value.validate().map_err(|source| Error::Invalid { kind: T::KIND, source })?;
     Ok(value)
 }
 
@@ -339,11 +288,7 @@ pub fn read<T: Artifact>(path: impl AsRef<Path>) -> Result<(Header, T)> {
 
 /// Validate, encode and atomically write an artifact (temporary file in the same folder, then
 /// rename), so a reader never sees a half-written file. Returns the header written.
-pub fn write<T: Artifact>(
-    path: impl AsRef<Path>,
-    value: &T,
-    provenance: &Provenance,
-) -> Result<Header> {
+pub fn write<T: Artifact>(path: impl AsRef<Path>, value: &T, provenance: &Provenance) -> Result<Header> {
     let path = path.as_ref();
     let bytes = encode(value, provenance).map_err(|e| e.at(path))?;
     let (header, _) = decode_header(&bytes)?;
@@ -368,10 +313,7 @@ pub fn replace_atomically(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".yarnhom-")
-        .suffix(".tmp")
-        .tempfile_in(dir)?;
+    let mut tmp = tempfile::Builder::new().prefix(".yarnhom-").suffix(".tmp").tempfile_in(dir)?;
     let tmp_path = tmp.path().to_path_buf();
     fill(&tmp_path, tmp.as_file_mut())?;
     tmp.as_file().sync_all()?;

@@ -7,9 +7,9 @@
 
 use serde::Serialize;
 
+use crate::AnyArtifact;
 use crate::pattern::Pattern;
 use crate::yarnmodel::YarnModel;
-use crate::AnyArtifact;
 
 /// Tolerances of a comparison.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -96,7 +96,14 @@ impl Diff {
             self.structural.push(format!("{field}: {} vs {} entries", a.len(), b.len()));
             return;
         }
-        let mut d = FieldDiff { field: field.into(), count: a.len(), max_abs: 0.0, rms: 0.0, worst_index: 0, outside: 0 };
+        let mut d = FieldDiff {
+            field: field.into(),
+            count: a.len(),
+            max_abs: 0.0,
+            rms: 0.0,
+            worst_index: 0,
+            outside: 0,
+        };
         let mut sum_sq = 0.0;
         for (i, (ra, rb)) in a.iter().zip(b).enumerate() {
             let sq: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
@@ -162,8 +169,18 @@ pub fn diff_patterns(a: &Pattern, b: &Pattern, tol: Tolerance) -> Diff {
             d.values("rest.edge_length_m", &ra.edge_length_m, &rb.edge_length_m, tol);
             d.rows("rest.vertex_curvature", &ra.vertex_curvature, &rb.vertex_curvature, tol);
             d.values("rest.vertex_twist_rad", &ra.vertex_twist_rad, &rb.vertex_twist_rad, tol);
-            d.rows("rest.edge_reference_director", &ra.edge_reference_director, &rb.edge_reference_director, tol);
-            d.values("rest.vertex_reference_twist_rad", &ra.vertex_reference_twist_rad, &rb.vertex_reference_twist_rad, tol);
+            d.rows(
+                "rest.edge_reference_director",
+                &ra.edge_reference_director,
+                &rb.edge_reference_director,
+                tol,
+            );
+            d.values(
+                "rest.vertex_reference_twist_rad",
+                &ra.vertex_reference_twist_rad,
+                &rb.vertex_reference_twist_rad,
+                tol,
+            );
         }
         (None, None) => {}
         (x, _) => d.structural.push(format!(

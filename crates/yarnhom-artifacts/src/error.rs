@@ -18,9 +18,7 @@ pub enum Error {
         found: Vec<u8>,
     },
     /// The container framing is newer than this build understands.
-    #[error(
-        "container version {found} is newer than the supported version {supported}; upgrade yarnhom"
-    )]
+    #[error("container version {found} is newer than the supported version {supported}; upgrade yarnhom")]
     NewerContainer {
         /// Version in the file.
         found: u16,
@@ -152,10 +150,7 @@ impl Error {
     pub fn at(self, path: impl Into<PathBuf>) -> Self {
         match self {
             Error::At { .. } => self,
-            other => Error::At {
-                path: path.into(),
-                source: Box::new(other),
-            },
+            other => Error::At { path: path.into(), source: Box::new(other) },
         }
     }
 
@@ -181,10 +176,7 @@ pub struct ValidationError {
 impl ValidationError {
     /// A validation error at `field`.
     pub fn new(field: impl Into<String>, problem: impl Into<String>) -> Self {
-        Self {
-            field: field.into(),
-            problem: problem.into(),
-        }
+        Self { field: field.into(), problem: problem.into() }
     }
 }
 

@@ -82,11 +82,7 @@ struct Spec {
     description: &'static str,
 }
 
-const PERIOD: Spec = Spec {
-    path: "/period_m",
-    units: "m",
-    description: "tile periods along X1 and X2",
-};
+const PERIOD: Spec = Spec { path: "/period_m", units: "m", description: "tile periods along X1 and X2" };
 const POSITIONS: Spec = Spec {
     path: "/positions_m",
     units: "m",
@@ -97,11 +93,7 @@ const EDGE_TWIST: Spec = Spec {
     units: "rad",
     description: "twist of the material frame relative to the reference frame on the edge leaving each vertex",
 };
-const YARN_RADIUS: Spec = Spec {
-    path: "/yarns/radius_m",
-    units: "m",
-    description: "radius of each yarn",
-};
+const YARN_RADIUS: Spec = Spec { path: "/yarns/radius_m", units: "m", description: "radius of each yarn" };
 const YARN_START: Spec = Spec {
     path: "/yarns/vertex_start",
     units: "1",
@@ -127,11 +119,8 @@ const REST_CURVATURE: Spec = Spec {
     units: "1",
     description: "rest material curvature (kappa1, kappa2) at each vertex, integrated (dimensionless)",
 };
-const REST_TWIST: Spec = Spec {
-    path: "/rest/vertex_twist_rad",
-    units: "rad",
-    description: "rest twist at each vertex",
-};
+const REST_TWIST: Spec =
+    Spec { path: "/rest/vertex_twist_rad", units: "rad", description: "rest twist at each vertex" };
 const REST_DIRECTOR: Spec = Spec {
     path: "/rest/edge_reference_director",
     units: "1",
@@ -157,8 +146,7 @@ pub fn export(path: &Path, header: &Header, artifact: &AnyArtifact) -> Result<()
         AnyArtifact::Pattern(p) => export_pattern(path, header, p),
         AnyArtifact::YarnModel(_) => Err(Error::Unrepresentable {
             format: FORMAT,
-            message: "a yarnmodel holds no arrays, so it has no HDF5 layout; use `--to json`"
-                .into(),
+            message: "a yarnmodel holds no arrays, so it has no HDF5 layout; use `--to json`".into(),
         }),
     }
     .map_err(|e| e.at(path))
@@ -175,15 +163,10 @@ pub fn import(path: &Path) -> Result<(Header, AnyArtifact)> {
 // Export
 
 fn export_pattern(path: &Path, header: &Header, p: &Pattern) -> Result<()> {
-    p.validate().map_err(|source| Error::Invalid {
-        kind: Pattern::KIND,
-        source,
-    })?;
+    p.validate().map_err(|source| Error::Invalid { kind: Pattern::KIND, source })?;
     let content_hash = container::content_hash(&container::payload_of(p)?);
-    let inputs = serde_json::to_string(&header.inputs).map_err(|e| Error::Encode {
-        what: "inputs",
-        message: e.to_string(),
-    })?;
+    let inputs = serde_json::to_string(&header.inputs)
+        .map_err(|e| Error::Encode { what: "inputs", message: e.to_string() })?;
 
     container::replace_atomically(path, |tmp, _| {
         let file = File::with_options()
@@ -195,13 +178,7 @@ fn export_pattern(path: &Path, header: &Header, p: &Pattern) -> Result<()> {
     })
 }
 
-fn write_pattern(
-    root: &Group,
-    header: &Header,
-    p: &Pattern,
-    content_hash: &str,
-    inputs: &str,
-) -> Result<()> {
+fn write_pattern(root: &Group, header: &Header, p: &Pattern, content_hash: &str, inputs: &str) -> Result<()> {
     write_str_attr(root, KIND_ATTR, Pattern::KIND)?;
     write_u32_attr(root, "schema_version", Pattern::SCHEMA_VERSION)?;
     write_str_attr(root, "content_hash", content_hash)?;
@@ -238,25 +215,10 @@ fn write_pattern(
     if let Some(rest) = &p.rest {
         create_group(root, "rest")?;
         write_dataset(root, &REST_LENGTH, &[n], &rest.edge_length_m)?;
-        write_dataset(
-            root,
-            &REST_CURVATURE,
-            &[n, 2],
-            rest.vertex_curvature.as_flattened(),
-        )?;
+        write_dataset(root, &REST_CURVATURE, &[n, 2], rest.vertex_curvature.as_flattened())?;
         write_dataset(root, &REST_TWIST, &[n], &rest.vertex_twist_rad)?;
-        write_dataset(
-            root,
-            &REST_DIRECTOR,
-            &[n, 3],
-            rest.edge_reference_director.as_flattened(),
-        )?;
-        write_dataset(
-            root,
-            &REST_REF_TWIST,
-            &[n],
-            &rest.vertex_reference_twist_rad,
-        )?;
+        write_dataset(root, &REST_DIRECTOR, &[n, 3], rest.edge_reference_director.as_flattened())?;
+        write_dataset(root, &REST_REF_TWIST, &[n], &rest.vertex_reference_twist_rad)?;
     }
     Ok(())
 }
@@ -277,8 +239,7 @@ fn write_dataset<T: H5Type>(root: &Group, spec: &Spec, shape: &[usize], data: &[
         .shape(shape)
         .create(spec.path)
         .map_err(|e| h5(format_args!("cannot create dataset {}", spec.path), e))?;
-    ds.write_raw(data)
-        .map_err(|e| h5(format_args!("cannot write dataset {}", spec.path), e))?;
+    ds.write_raw(data).map_err(|e| h5(format_args!("cannot write dataset {}", spec.path), e))?;
     write_str_attr(&ds, "units", spec.units)?;
     write_str_attr(&ds, "description", spec.description)
 }
@@ -352,12 +313,8 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
         version: read_str_attr(root, "producer_version")?,
     };
     let created_utc = read_str_attr(root, "created_utc")?;
-    let inputs: Vec<InputRef> =
-        serde_json::from_str(&read_str_attr(root, "inputs")?).map_err(|e| {
-            Error::Hdf5(format!(
-                "root attribute 'inputs' is not a JSON list of inputs: {e}"
-            ))
-        })?;
+    let inputs: Vec<InputRef> = serde_json::from_str(&read_str_attr(root, "inputs")?)
+        .map_err(|e| Error::Hdf5(format!("root attribute 'inputs' is not a JSON list of inputs: {e}")))?;
     let name = read_str_attr(root, "name")?;
     let fabric = match read_str_attr(root, "fabric")?.as_str() {
         "knit" => Fabric::Knit,
@@ -396,9 +353,7 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
             edge_length_m: read_dataset(root, &REST_LENGTH, &[Some(n)])?.0,
             vertex_curvature: rows(read_dataset(root, &REST_CURVATURE, &[Some(n), Some(2)])?.0),
             vertex_twist_rad: read_dataset(root, &REST_TWIST, &[Some(n)])?.0,
-            edge_reference_director: rows(
-                read_dataset(root, &REST_DIRECTOR, &[Some(n), Some(3)])?.0,
-            ),
+            edge_reference_director: rows(read_dataset(root, &REST_DIRECTOR, &[Some(n), Some(3)])?.0),
             vertex_reference_twist_rad: read_dataset(root, &REST_REF_TWIST, &[Some(n)])?.0,
         })
     } else {
@@ -415,17 +370,11 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
         rest,
         origin,
     };
-    pattern.validate().map_err(|source| Error::Invalid {
-        kind: Pattern::KIND,
-        source,
-    })?;
+    pattern.validate().map_err(|source| Error::Invalid { kind: Pattern::KIND, source })?;
     let payload = container::payload_of(&pattern)?;
     let computed = container::content_hash(&payload);
     if computed != stored_hash {
-        return Err(Error::ContentHashMismatch {
-            stored: stored_hash,
-            computed,
-        });
+        return Err(Error::ContentHashMismatch { stored: stored_hash, computed });
     }
     let header = Header {
         kind: Pattern::KIND.into(),
@@ -446,9 +395,7 @@ fn csr_ranges(start: &[u64], n: usize) -> Result<Vec<std::ops::Range<usize>>> {
         source: ValidationError::new(YARN_START.path, problem),
     };
     let (Some(&first), Some(&last)) = (start.first(), start.last()) else {
-        return Err(bad(
-            "is empty; it needs one entry more than there are yarns".into(),
-        ));
+        return Err(bad("is empty; it needs one entry more than there are yarns".into()));
     };
     if first != 0 {
         return Err(bad(format!("must start at 0, starts at {first}")));
@@ -481,9 +428,7 @@ fn csr_ranges(start: &[u64], n: usize) -> Result<Vec<std::ops::Range<usize>>> {
 
 /// Group a flat row-major array into rows of `N` (the length is a multiple of `N`).
 fn rows<T: Copy, const N: usize>(flat: Vec<T>) -> Vec<[T; N]> {
-    flat.chunks_exact(N)
-        .map(|c| std::array::from_fn(|i| c[i]))
-        .collect()
+    flat.chunks_exact(N).map(|c| std::array::from_fn(|i| c[i])).collect()
 }
 
 /// Does `path` (absolute, `/a/b`) name a link in the file? Checks each level, as HDF5 refuses
@@ -518,33 +463,21 @@ fn read_dataset<T: H5Type>(
         .map_err(|e| h5(format_args!("dataset {}: unreadable dtype", spec.path), e))?;
     let want = T::type_descriptor();
     if found != want {
-        return Err(Error::Hdf5(format!(
-            "dataset {} has dtype {found}, expected {want}",
-            spec.path
-        )));
+        return Err(Error::Hdf5(format!("dataset {} has dtype {found}, expected {want}", spec.path)));
     }
-    let shape = ds
-        .get_shape()
-        .map_err(|e| h5(format_args!("dataset {}: unreadable shape", spec.path), e))?;
-    let fits = shape.len() == expected.len()
-        && shape
-            .iter()
-            .zip(expected)
-            .all(|(&s, e)| e.is_none_or(|e| e == s));
+    let shape = ds.get_shape().map_err(|e| h5(format_args!("dataset {}: unreadable shape", spec.path), e))?;
+    let fits =
+        shape.len() == expected.len() && shape.iter().zip(expected).all(|(&s, e)| e.is_none_or(|e| e == s));
     if !fits {
-        let want: Vec<String> = expected
-            .iter()
-            .map(|e| e.map_or("any".to_string(), |e| e.to_string()))
-            .collect();
+        let want: Vec<String> =
+            expected.iter().map(|e| e.map_or("any".to_string(), |e| e.to_string())).collect();
         return Err(Error::Hdf5(format!(
             "dataset {} has shape {shape:?}, expected [{}]",
             spec.path,
             want.join(", ")
         )));
     }
-    let data = ds
-        .read_raw::<T>()
-        .map_err(|e| h5(format_args!("cannot read dataset {}", spec.path), e))?;
+    let data = ds.read_raw::<T>().map_err(|e| h5(format_args!("cannot read dataset {}", spec.path), e))?;
     if data.len() != shape.iter().product::<usize>() {
         return Err(Error::Hdf5(format!(
             "dataset {}: read {} values for shape {shape:?}",
@@ -556,9 +489,7 @@ fn read_dataset<T: H5Type>(
 }
 
 fn has_attr(loc: &Location, name: &str) -> Result<bool> {
-    let names = loc
-        .attr_names()
-        .map_err(|e| h5("cannot list the root attributes", e))?;
+    let names = loc.attr_names().map_err(|e| h5("cannot list the root attributes", e))?;
     Ok(names.iter().any(|a| a == name))
 }
 
@@ -566,22 +497,19 @@ fn open_attr(loc: &Location, name: &str) -> Result<::hdf5::Attribute> {
     if !has_attr(loc, name)? {
         return Err(Error::Hdf5(format!("missing root attribute '{name}'")));
     }
-    loc.attr(name)
-        .map_err(|e| h5(format_args!("cannot open root attribute '{name}'"), e))
+    loc.attr(name).map_err(|e| h5(format_args!("cannot open root attribute '{name}'"), e))
 }
 
 fn read_str_attr(loc: &Location, name: &str) -> Result<String> {
     let attr = open_attr(loc, name)?;
     let err = |e| h5(format_args!("cannot read root attribute '{name}'"), e);
     match attr.dtype().and_then(|t| t.to_descriptor()).map_err(err)? {
-        TypeDescriptor::VarLenUnicode => attr
-            .read_scalar::<VarLenUnicode>()
-            .map(|s| s.as_str().to_owned())
-            .map_err(err),
-        TypeDescriptor::VarLenAscii => attr
-            .read_scalar::<VarLenAscii>()
-            .map(|s| s.as_str().to_owned())
-            .map_err(err),
+        TypeDescriptor::VarLenUnicode => {
+            attr.read_scalar::<VarLenUnicode>().map(|s| s.as_str().to_owned()).map_err(err)
+        }
+        TypeDescriptor::VarLenAscii => {
+            attr.read_scalar::<VarLenAscii>().map(|s| s.as_str().to_owned()).map_err(err)
+        }
         other => Err(Error::Hdf5(format!(
             "root attribute '{name}' has type {other}, expected a variable-length string"
         ))),
@@ -595,14 +523,10 @@ fn read_u32_attr(loc: &Location, name: &str) -> Result<u32> {
         TypeDescriptor::Integer(_) | TypeDescriptor::Unsigned(_) => {
             let v = attr.read_scalar::<i64>().map_err(err)?;
             u32::try_from(v).map_err(|_| {
-                Error::Hdf5(format!(
-                    "root attribute '{name}' is {v}, expected an unsigned 32-bit integer"
-                ))
+                Error::Hdf5(format!("root attribute '{name}' is {v}, expected an unsigned 32-bit integer"))
             })
         }
-        other => Err(Error::Hdf5(format!(
-            "root attribute '{name}' has type {other}, expected an integer"
-        ))),
+        other => Err(Error::Hdf5(format!("root attribute '{name}' has type {other}, expected an integer"))),
     }
 }
 
@@ -665,10 +589,7 @@ mod tests {
     fn header_of(p: &Pattern) -> Header {
         let payload = container::payload_of(p).unwrap();
         let provenance = container::Provenance {
-            producer: Producer {
-                name: "yarnhom test".into(),
-                version: "9.9.9".into(),
-            },
+            producer: Producer { name: "yarnhom test".into(), version: "9.9.9".into() },
             inputs: vec![InputRef {
                 kind: "pyp".into(),
                 content_hash: container::content_hash(b"abc"),
@@ -701,9 +622,7 @@ mod tests {
         let header = header_of(&p);
         export(&path, &header, &AnyArtifact::Pattern(p.clone())).unwrap();
         let (h, back) = import(&path).unwrap();
-        let AnyArtifact::Pattern(back) = back else {
-            panic!("not a pattern")
-        };
+        let AnyArtifact::Pattern(back) = back else { panic!("not a pattern") };
         assert_eq!(back, p);
         assert_eq!(bits(&back), bits(&p));
         assert_eq!(h, header);
@@ -772,10 +691,7 @@ mod tests {
         let path = dir.path().join("foreign.h5");
         {
             let f = File::create(&path).unwrap();
-            f.new_dataset_builder()
-                .with_data(&[1.0f64, 2.0, 3.0])
-                .create("temperature")
-                .unwrap();
+            f.new_dataset_builder().with_data(&[1.0f64, 2.0, 3.0]).create("temperature").unwrap();
         }
         let e = import(&path).unwrap_err();
         let message = e.to_string();
@@ -814,16 +730,9 @@ mod tests {
     #[test]
     fn missing_dataset_is_named() {
         let e = import_error_after(|f| f.unlink("yarns/vertices").unwrap());
-        assert!(
-            e.to_string().contains("missing dataset /yarns/vertices"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("missing dataset /yarns/vertices"), "{e}");
         let e = import_error_after(|f| f.unlink("rest/vertex_twist_rad").unwrap());
-        assert!(
-            e.to_string()
-                .contains("missing dataset /rest/vertex_twist_rad"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("missing dataset /rest/vertex_twist_rad"), "{e}");
         let e = import_error_after(|f| f.unlink("yarns").unwrap());
         assert!(e.to_string().contains("missing dataset /yarns/"), "{e}");
     }
@@ -832,39 +741,24 @@ mod tests {
     fn wrong_dtype_is_named() {
         let e = import_error_after(|f| {
             f.unlink("yarns/vertices").unwrap();
-            f.new_dataset_builder()
-                .with_data(&[0.0f64; 7])
-                .create("yarns/vertices")
-                .unwrap();
+            f.new_dataset_builder().with_data(&[0.0f64; 7]).create("yarns/vertices").unwrap();
         });
         let message = e.to_string();
         assert!(message.contains("/yarns/vertices"), "{message}");
-        assert!(
-            message.contains("dtype float64, expected uint32"),
-            "{message}"
-        );
+        assert!(message.contains("dtype float64, expected uint32"), "{message}");
     }
 
     #[test]
     fn wrong_shape_is_named() {
         let e = import_error_after(|f| {
             f.unlink("edge_twist_rad").unwrap();
-            f.new_dataset_builder()
-                .with_data(&[0.0f64; 6])
-                .create("edge_twist_rad")
-                .unwrap();
+            f.new_dataset_builder().with_data(&[0.0f64; 6]).create("edge_twist_rad").unwrap();
         });
         let message = e.to_string();
-        assert!(
-            message.contains("dataset /edge_twist_rad has shape [6], expected [7]"),
-            "{message}"
-        );
+        assert!(message.contains("dataset /edge_twist_rad has shape [6], expected [7]"), "{message}");
         let e = import_error_after(|f| {
             f.unlink("positions_m").unwrap();
-            f.new_dataset_builder()
-                .with_data(&[0.0f64; 14])
-                .create("positions_m")
-                .unwrap();
+            f.new_dataset_builder().with_data(&[0.0f64; 14]).create("positions_m").unwrap();
         });
         assert!(e.to_string().contains("/positions_m has shape [14]"), "{e}");
     }
@@ -872,19 +766,13 @@ mod tests {
     #[test]
     fn broken_csr_and_invariants_are_refused() {
         let e = import_error_after(|f| {
-            f.dataset("yarns/vertex_start")
-                .unwrap()
-                .write_raw(&[0u64, 5, 4])
-                .unwrap();
+            f.dataset("yarns/vertex_start").unwrap().write_raw(&[0u64, 5, 4]).unwrap();
         });
         assert!(matches!(e.root(), Error::Invalid { .. }), "{e}");
         assert!(e.to_string().contains("/yarns/vertex_start"), "{e}");
         // A duplicated vertex: the CSR is fine, the pattern is not.
         let e = import_error_after(|f| {
-            f.dataset("yarns/vertices")
-                .unwrap()
-                .write_raw(&[0u32, 2, 4, 6, 1, 3, 3])
-                .unwrap();
+            f.dataset("yarns/vertices").unwrap().write_raw(&[0u32, 2, 4, 6, 1, 3, 3]).unwrap();
         });
         assert!(matches!(e.root(), Error::Invalid { .. }), "{e}");
     }
@@ -892,10 +780,7 @@ mod tests {
     #[test]
     fn modified_data_fails_the_content_hash() {
         let e = import_error_after(|f| {
-            f.dataset("edge_twist_rad")
-                .unwrap()
-                .write_raw(&[0.5f64; 7])
-                .unwrap();
+            f.dataset("edge_twist_rad").unwrap().write_raw(&[0.5f64; 7]).unwrap();
         });
         assert!(matches!(e.root(), Error::ContentHashMismatch { .. }), "{e}");
     }
@@ -903,29 +788,16 @@ mod tests {
     #[test]
     fn bad_root_attributes_are_named() {
         let e = import_error_after(|f| f.delete_attr("created_utc").unwrap());
-        assert!(
-            e.to_string()
-                .contains("missing root attribute 'created_utc'"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("missing root attribute 'created_utc'"), "{e}");
         let e = import_error_after(|f| {
-            f.attr("schema_version")
-                .unwrap()
-                .write_scalar(&2u32)
-                .unwrap();
+            f.attr("schema_version").unwrap().write_scalar(&2u32).unwrap();
         });
-        assert!(
-            matches!(e.root(), Error::NewerSchema { found: 2, .. }),
-            "{e}"
-        );
+        assert!(matches!(e.root(), Error::NewerSchema { found: 2, .. }), "{e}");
         let e = import_error_after(|f| {
             let v: VarLenUnicode = "fleece".parse().unwrap();
             f.attr("yarnhom_kind").unwrap().write_scalar(&v).unwrap();
         });
-        assert!(
-            matches!(e.root(), Error::UnknownKind(k) if k == "fleece"),
-            "{e}"
-        );
+        assert!(matches!(e.root(), Error::UnknownKind(k) if k == "fleece"), "{e}");
         let e = import_error_after(|f| {
             let v: VarLenUnicode = "felt".parse().unwrap();
             f.attr("fabric").unwrap().write_scalar(&v).unwrap();

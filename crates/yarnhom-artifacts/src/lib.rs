@@ -8,8 +8,8 @@
 //! - [`schema`]: JSON Schemas generated from the types.
 
 pub mod check;
-pub mod diff;
 pub mod container;
+pub mod diff;
 pub mod error;
 #[cfg(feature = "hdf5")]
 pub mod hdf5;
@@ -37,11 +37,7 @@ pub trait Artifact: Serialize + DeserializeOwned + schemars::JsonSchema {
     fn summary(&self) -> String;
     /// Decode a msgpack payload of an older schema version. Kinds without history refuse.
     fn migrate(version: u32, _payload: &[u8]) -> Result<Self> {
-        Err(Error::NoMigration {
-            kind: Self::KIND.into(),
-            found: version,
-            supported: Self::SCHEMA_VERSION,
-        })
+        Err(Error::NoMigration { kind: Self::KIND.into(), found: version, supported: Self::SCHEMA_VERSION })
     }
 }
 
@@ -159,14 +155,9 @@ impl AnyArtifact {
 
     /// Decode a [`JsonDocument`], migrating an older schema version like a `.yh` file would.
     pub fn from_json_document(doc: &JsonDocument) -> Result<Self> {
-        let payload = rmp_serde::to_vec_named(&doc.payload).map_err(|e| Error::Encode {
-            what: "payload",
-            message: e.to_string(),
-        })?;
-        let header = Header {
-            content_hash: container::content_hash(&payload),
-            ..doc.header.clone()
-        };
+        let payload = rmp_serde::to_vec_named(&doc.payload)
+            .map_err(|e| Error::Encode { what: "payload", message: e.to_string() })?;
+        let header = Header { content_hash: container::content_hash(&payload), ..doc.header.clone() };
         Self::decode(&RawArtifact { header, payload })
     }
 }

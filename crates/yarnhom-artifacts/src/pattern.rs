@@ -50,9 +50,7 @@ impl Yarn {
     /// The total tile shift accumulated along one pass of the yarn: where the yarn re-enters
     /// itself. `(1, 0)` for a yarn running along X1.
     pub fn closure_offset(&self) -> [i32; 2] {
-        self.edge_offsets
-            .iter()
-            .fold([0, 0], |a, o| [a[0] + o[0], a[1] + o[1]])
+        self.edge_offsets.iter().fold([0, 0], |a, o| [a[0] + o[0], a[1] + o[1]])
     }
 }
 
@@ -132,11 +130,7 @@ impl Pattern {
     /// Position of vertex `v` shifted by `offset` tiles.
     pub fn shifted(&self, v: u32, offset: [i32; 2]) -> [f64; 3] {
         let x = self.positions_m[v as usize];
-        [
-            x[0] + f64::from(offset[0]) * self.period_m[0],
-            x[1] + f64::from(offset[1]) * self.period_m[1],
-            x[2],
-        ]
+        [x[0] + f64::from(offset[0]) * self.period_m[0], x[1] + f64::from(offset[1]) * self.period_m[1], x[2]]
     }
 
     /// The vector of an edge, end minus start (m).
@@ -150,9 +144,7 @@ impl Pattern {
     pub fn radius_range_m(&self) -> (f64, f64) {
         self.yarns
             .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| {
-                (lo.min(y.radius_m), hi.max(y.radius_m))
-            })
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y.radius_m), hi.max(y.radius_m)))
     }
 
     /// Check every invariant of a pattern; the error names the offending field.
@@ -164,10 +156,7 @@ impl Pattern {
         check::len("edge_twist_rad", self.edge_twist_rad.len(), n, "vertices")?;
         check::finite("edge_twist_rad", &self.edge_twist_rad)?;
         if self.yarns.is_empty() {
-            return Err(ValidationError::new(
-                "yarns",
-                "a pattern needs at least one yarn",
-            ));
+            return Err(ValidationError::new("yarns", "a pattern needs at least one yarn"));
         }
         self.validate_yarns()?;
         self.validate_edge_lengths()?;
@@ -186,10 +175,7 @@ impl Pattern {
             if yarn.vertices.len() < 3 {
                 return Err(ValidationError::new(
                     field("vertices"),
-                    format!(
-                        "a closed yarn needs at least 3 vertices, got {}",
-                        yarn.vertices.len()
-                    ),
+                    format!("a closed yarn needs at least 3 vertices, got {}", yarn.vertices.len()),
                 ));
             }
             check::len(
@@ -230,10 +216,7 @@ impl Pattern {
             }
         }
         if let Some(v) = owner.iter().position(Option::is_none) {
-            return Err(ValidationError::new(
-                format!("positions_m[{v}]"),
-                "vertex belongs to no yarn",
-            ));
+            return Err(ValidationError::new(format!("positions_m[{v}]"), "vertex belongs to no yarn"));
         }
         Ok(())
     }
@@ -262,14 +245,8 @@ impl Pattern {
             format!("{:.4}-{:.4} mm", r_lo * 1e3, r_hi * 1e3)
         };
         let z = self.positions_m.iter().map(|p| p[2]);
-        let (z_lo, z_hi) = z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| {
-            (a.min(z), b.max(z))
-        });
-        let closures: Vec<String> = self
-            .yarns
-            .iter()
-            .map(|y| format!("{:?}", y.closure_offset()))
-            .collect();
+        let (z_lo, z_hi) = z.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), z| (a.min(z), b.max(z)));
+        let closures: Vec<String> = self.yarns.iter().map(|y| format!("{:?}", y.closure_offset())).collect();
         format!(
             "pattern '{}' ({} fabric)\n  periods: {:.4} mm x {:.4} mm\n  yarns: {} (closure offsets {})\n  vertices: {} (edges: {})\n  yarn radius: {}\n  thickness (centrelines): {:.4} mm\n  rest state: {}\n  origin: {}",
             self.name,
@@ -295,10 +272,7 @@ impl Pattern {
             .iter()
             .map(|yarn| {
                 let c = yarn.closure_offset();
-                let d = [
-                    f64::from(c[0]) * self.period_m[0],
-                    f64::from(c[1]) * self.period_m[1],
-                ];
+                let d = [f64::from(c[0]) * self.period_m[0], f64::from(c[1]) * self.period_m[1]];
                 let norm = d[0].hypot(d[1]);
                 [d[0] / norm, d[1] / norm]
             })
@@ -308,56 +282,24 @@ impl Pattern {
             let u = run_direction[e.yarn];
             d[0] * u[0] + d[1] * u[1] < -0.25 * self.yarns[e.yarn].radius_m
         });
-        if loops_back {
-            Fabric::Knit
-        } else {
-            Fabric::Woven
-        }
+        if loops_back { Fabric::Knit } else { Fabric::Woven }
     }
 }
 
 impl RestState {
     fn validate(&self, n: usize) -> Result<(), ValidationError> {
-        check::len(
-            "rest.edge_length_m",
-            self.edge_length_m.len(),
-            n,
-            "vertices",
-        )?;
-        check::len(
-            "rest.vertex_curvature",
-            self.vertex_curvature.len(),
-            n,
-            "vertices",
-        )?;
-        check::len(
-            "rest.vertex_twist_rad",
-            self.vertex_twist_rad.len(),
-            n,
-            "vertices",
-        )?;
-        check::len(
-            "rest.edge_reference_director",
-            self.edge_reference_director.len(),
-            n,
-            "vertices",
-        )?;
-        check::len(
-            "rest.vertex_reference_twist_rad",
-            self.vertex_reference_twist_rad.len(),
-            n,
-            "vertices",
-        )?;
+        check::len("rest.edge_length_m", self.edge_length_m.len(), n, "vertices")?;
+        check::len("rest.vertex_curvature", self.vertex_curvature.len(), n, "vertices")?;
+        check::len("rest.vertex_twist_rad", self.vertex_twist_rad.len(), n, "vertices")?;
+        check::len("rest.edge_reference_director", self.edge_reference_director.len(), n, "vertices")?;
+        check::len("rest.vertex_reference_twist_rad", self.vertex_reference_twist_rad.len(), n, "vertices")?;
         for (i, &l) in self.edge_length_m.iter().enumerate() {
             check::positive(&format!("rest.edge_length_m[{i}]"), l)?;
         }
         check::finite_rows("rest.vertex_curvature", &self.vertex_curvature)?;
         check::finite("rest.vertex_twist_rad", &self.vertex_twist_rad)?;
         check::finite_rows("rest.edge_reference_director", &self.edge_reference_director)?;
-        check::finite(
-            "rest.vertex_reference_twist_rad",
-            &self.vertex_reference_twist_rad,
-        )?;
+        check::finite("rest.vertex_reference_twist_rad", &self.vertex_reference_twist_rad)?;
         for (i, d) in self.edge_reference_director.iter().enumerate() {
             let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             if (norm - 1.0).abs() > 1e-3 {

@@ -29,11 +29,7 @@ use crate::pattern::{Fabric, Pattern, RestState, Yarn};
 const FORMAT: &str = ".pyp";
 
 fn err(line: usize, message: impl Into<String>) -> Error {
-    Error::Format {
-        format: FORMAT,
-        line,
-        message: message.into(),
-    }
+    Error::Format { format: FORMAT, line, message: message.into() }
 }
 
 /// Numeric rows of a section, each with its 1-based line number.
@@ -56,15 +52,9 @@ fn sections(text: &str) -> Result<Vec<Section>> {
             if out.iter().any(|s| s.name == name) {
                 return Err(err(line, format!("section *{name} appears twice")));
             }
-            out.push(Section {
-                name,
-                line,
-                rows: Vec::new(),
-            });
+            out.push(Section { name, line, rows: Vec::new() });
         } else if !content.is_empty() {
-            let section = out
-                .last_mut()
-                .ok_or_else(|| err(line, "data before the first *section header"))?;
+            let section = out.last_mut().ok_or_else(|| err(line, "data before the first *section header"))?;
             let values = content
                 .split_whitespace()
                 .map(|t| {
@@ -81,36 +71,20 @@ fn sections(text: &str) -> Result<Vec<Section>> {
 }
 
 /// Rows of one section, checked for count and width.
-fn table<'a>(
-    all: &'a [Section],
-    name: &str,
-    rows: usize,
-    cols: usize,
-) -> Result<Option<&'a Rows>> {
+fn table<'a>(all: &'a [Section], name: &str, rows: usize, cols: usize) -> Result<Option<&'a Rows>> {
     let Some(s) = all.iter().find(|s| s.name == name) else {
         return Ok(None);
     };
     if s.rows.len() != rows {
-        return Err(err(
-            s.line,
-            format!("section *{name} has {} rows, expected {rows}", s.rows.len()),
-        ));
+        return Err(err(s.line, format!("section *{name} has {} rows, expected {rows}", s.rows.len())));
     }
     if let Some((line, row)) = s.rows.iter().find(|(_, r)| r.len() != cols) {
-        return Err(err(
-            *line,
-            format!("section *{name} needs {cols} columns, found {}", row.len()),
-        ));
+        return Err(err(*line, format!("section *{name} needs {cols} columns, found {}", row.len())));
     }
     Ok(Some(&s.rows))
 }
 
-fn required<'a>(
-    all: &'a [Section],
-    name: &str,
-    rows: usize,
-    cols: usize,
-) -> Result<&'a Rows> {
+fn required<'a>(all: &'a [Section], name: &str, rows: usize, cols: usize) -> Result<&'a Rows> {
     table(all, name, rows, cols)?.ok_or_else(|| err(0, format!("missing section *{name}")))
 }
 
@@ -130,10 +104,7 @@ pub fn parse_pyp(text: &str, name: &str, fabric: Option<Fabric>) -> Result<Patte
     let (head_line, h) = (&head[0].0, &head[0].1);
     let n = integer(*head_line, h[3], "num_vertedges")?;
     if n < 3 {
-        return Err(err(
-            *head_line,
-            format!("num_vertedges must be at least 3, got {n}"),
-        ));
+        return Err(err(*head_line, format!("num_vertedges must be at least 3, got {n}")));
     }
     let n = n as usize;
     let q = required(&all, "Q", n, 4)?;
@@ -153,10 +124,7 @@ pub fn parse_pyp(text: &str, name: &str, fabric: Option<Fabric>) -> Result<Patte
     if fabric.is_none() {
         pattern.fabric = pattern.infer_fabric();
     }
-    pattern.validate().map_err(|source| Error::Invalid {
-        kind: "pattern",
-        source,
-    })?;
+    pattern.validate().map_err(|source| Error::Invalid { kind: "pattern", source })?;
     Ok(pattern)
 }
 
@@ -181,16 +149,10 @@ fn yarns_from_edges(rows: &Rows, n: usize, radius: f64) -> Result<Vec<Yarn>> {
         };
         let o = [offset(r[2], "dx")?, offset(r[3], "dy")?];
         if let Some((_, _, first)) = next[a] {
-            return Err(err(
-                line,
-                format!("vertex {a} already has an outgoing edge (line {first})"),
-            ));
+            return Err(err(line, format!("vertex {a} already has an outgoing edge (line {first})")));
         }
         if let Some(first) = incoming[b] {
-            return Err(err(
-                line,
-                format!("vertex {b} already has an incoming edge (line {first})"),
-            ));
+            return Err(err(line, format!("vertex {b} already has an incoming edge (line {first})")));
         }
         next[a] = Some((b as u32, o, line));
         incoming[b] = Some(line);
@@ -201,11 +163,7 @@ fn yarns_from_edges(rows: &Rows, n: usize, radius: f64) -> Result<Vec<Yarn>> {
         if seen[start] {
             continue;
         }
-        let mut yarn = Yarn {
-            radius_m: radius,
-            vertices: Vec::new(),
-            edge_offsets: Vec::new(),
-        };
+        let mut yarn = Yarn { radius_m: radius, vertices: Vec::new(), edge_offsets: Vec::new() };
         let mut v = start;
         while !seen[v] {
             seen[v] = true;
@@ -222,37 +180,19 @@ fn yarns_from_edges(rows: &Rows, n: usize, radius: f64) -> Result<Vec<Yarn>> {
 
 fn rest_state(all: &[Section], n: usize) -> Result<Option<RestState>> {
     let names = ["RL", "RK", "RT", "RefD1", "RefT"];
-    let present: Vec<&str> = names
-        .iter()
-        .copied()
-        .filter(|m| all.iter().any(|s| s.name == *m))
-        .collect();
+    let present: Vec<&str> = names.iter().copied().filter(|m| all.iter().any(|s| s.name == *m)).collect();
     if present.is_empty() {
         return Ok(None);
     }
     if present.len() < names.len() {
-        let missing: Vec<&str> = names
-            .iter()
-            .copied()
-            .filter(|m| !present.contains(m))
-            .collect();
-        return Err(err(
-            0,
-            format!("rest state is incomplete: missing *{}", missing.join(", *")),
-        ));
+        let missing: Vec<&str> = names.iter().copied().filter(|m| !present.contains(m)).collect();
+        return Err(err(0, format!("rest state is incomplete: missing *{}", missing.join(", *"))));
     }
-    let col = |name, c| -> Result<Vec<f64>> {
-        Ok(required(all, name, n, c)?
-            .iter()
-            .map(|(_, r)| r[0])
-            .collect())
-    };
+    let col =
+        |name, c| -> Result<Vec<f64>> { Ok(required(all, name, n, c)?.iter().map(|(_, r)| r[0]).collect()) };
     Ok(Some(RestState {
         edge_length_m: col("RL", 1)?,
-        vertex_curvature: required(all, "RK", n, 2)?
-            .iter()
-            .map(|(_, r)| [r[0], r[1]])
-            .collect(),
+        vertex_curvature: required(all, "RK", n, 2)?.iter().map(|(_, r)| [r[0], r[1]]).collect(),
         vertex_twist_rad: col("RT", 1)?,
         edge_reference_director: required(all, "RefD1", n, 3)?
             .iter()
@@ -266,11 +206,7 @@ fn rest_state(all: &[Section], n: usize) -> Result<Option<RestState>> {
 /// very large magnitudes.
 fn number(v: f64) -> String {
     let a = v.abs();
-    if a == 0.0 || (1e-4..1e15).contains(&a) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
+    if a == 0.0 || (1e-4..1e15).contains(&a) { format!("{v}") } else { format!("{v:e}") }
 }
 
 fn row(out: &mut String, values: &[f64]) {
@@ -292,13 +228,7 @@ pub fn write_pyp(p: &Pattern) -> Result<String> {
     let n = p.vertex_count();
     let mut out = String::new();
     out.push_str("*pattern # px py radius num_vertedges\n");
-    let _ = writeln!(
-        out,
-        "{} {} {} {n}",
-        number(p.period_m[0]),
-        number(p.period_m[1]),
-        number(lo)
-    );
+    let _ = writeln!(out, "{} {} {} {n}", number(p.period_m[0]), number(p.period_m[1]), number(lo));
     out.push_str("\n*Q # dofs: x y z t\n");
     for (x, t) in p.positions_m.iter().zip(&p.edge_twist_rad) {
         row(&mut out, &[x[0], x[1], x[2], *t]);
@@ -316,26 +246,11 @@ pub fn write_pyp(p: &Pattern) -> Result<String> {
                 row(&mut out, &r);
             }
         };
-        section(
-            "*RL # rest lengths",
-            &mut rest.edge_length_m.iter().map(|&v| vec![v]),
-        );
-        section(
-            "*RK # rest kappas",
-            &mut rest.vertex_curvature.iter().map(|k| k.to_vec()),
-        );
-        section(
-            "*RT # rest twists",
-            &mut rest.vertex_twist_rad.iter().map(|&v| vec![v]),
-        );
-        section(
-            "*RefD1 # reference directors",
-            &mut rest.edge_reference_director.iter().map(|d| d.to_vec()),
-        );
-        section(
-            "*RefT # reference twists",
-            &mut rest.vertex_reference_twist_rad.iter().map(|&v| vec![v]),
-        );
+        section("*RL # rest lengths", &mut rest.edge_length_m.iter().map(|&v| vec![v]));
+        section("*RK # rest kappas", &mut rest.vertex_curvature.iter().map(|k| k.to_vec()));
+        section("*RT # rest twists", &mut rest.vertex_twist_rad.iter().map(|&v| vec![v]));
+        section("*RefD1 # reference directors", &mut rest.edge_reference_director.iter().map(|d| d.to_vec()));
+        section("*RefT # reference twists", &mut rest.vertex_reference_twist_rad.iter().map(|&v| vec![v]));
     }
     Ok(out)
 }

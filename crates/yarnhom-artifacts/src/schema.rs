@@ -6,10 +6,7 @@ use crate::Artifact;
 pub fn of<T: Artifact>() -> serde_json::Value {
     let mut schema = serde_json::to_value(schemars::schema_for!(T)).unwrap_or_default();
     if let Some(map) = schema.as_object_mut() {
-        map.insert(
-            "$id".into(),
-            format!("yarnhom:{}.v{}", T::KIND, T::SCHEMA_VERSION).into(),
-        );
+        map.insert("$id".into(), format!("yarnhom:{}.v{}", T::KIND, T::SCHEMA_VERSION).into());
         map.insert(
             "description".into(),
             format!(

@@ -97,10 +97,7 @@ impl YarnModel {
 
     /// Named parameters with units, in a stable order (for summaries and diffs).
     pub fn parameters(&self) -> Vec<(&'static str, f64)> {
-        let mut out = vec![
-            ("radius_m", self.radius_m),
-            ("density_kg_m3", self.density_kg_m3),
-        ];
+        let mut out = vec![("radius_m", self.radius_m), ("density_kg_m3", self.density_kg_m3)];
         match self.mechanics {
             YarnMechanics::ElasticRod {
                 youngs_modulus_pa,
@@ -115,16 +112,7 @@ impl YarnModel {
                     ("contact_stiffness_kg_s2", contact_stiffness_kg_s2),
                 ]);
             }
-            YarnMechanics::Biphasic {
-                k_s1_n,
-                k_s2_n,
-                eps_bar,
-                k_b_nm2,
-                r1_m,
-                k_c1_n_m,
-                r2_m,
-                k_c2_n_m,
-            } => {
+            YarnMechanics::Biphasic { k_s1_n, k_s2_n, eps_bar, k_b_nm2, r1_m, k_c1_n_m, r2_m, k_c2_n_m } => {
                 out.extend([
                     ("k_s1_n", k_s1_n),
                     ("k_s2_n", k_s2_n),
@@ -148,20 +136,11 @@ impl YarnModel {
                 _ => check::positive(name, value)?,
             }
         }
-        if let YarnMechanics::Biphasic {
-            r1_m,
-            r2_m,
-            k_s1_n,
-            k_s2_n,
-            ..
-        } = self.mechanics
-        {
+        if let YarnMechanics::Biphasic { r1_m, r2_m, k_s1_n, k_s2_n, .. } = self.mechanics {
             if r2_m > r1_m {
                 return Err(ValidationError::new(
                     "r2_m",
-                    format!(
-                        "the inner contact radius ({r2_m}) must not exceed the outer one ({r1_m})"
-                    ),
+                    format!("the inner contact radius ({r2_m}) must not exceed the outer one ({r1_m})"),
                 ));
             }
             if k_s1_n > k_s2_n {
@@ -196,18 +175,11 @@ impl YarnModel {
     pub fn migrate(version: u32, payload: &[u8]) -> Result<Self, Error> {
         match version {
             0 => {
-                let v0: YarnModelV0 =
-                    rmp_serde::from_slice(payload).map_err(|e| Error::Decode {
-                        what: "yarnmodel v0",
-                        message: e.to_string(),
-                    })?;
+                let v0: YarnModelV0 = rmp_serde::from_slice(payload)
+                    .map_err(|e| Error::Decode { what: "yarnmodel v0", message: e.to_string() })?;
                 Ok(v0.into())
             }
-            _ => Err(Error::NoMigration {
-                kind: "yarnmodel".into(),
-                found: version,
-                supported: 1,
-            }),
+            _ => Err(Error::NoMigration { kind: "yarnmodel".into(), found: version, supported: 1 }),
         }
     }
 }

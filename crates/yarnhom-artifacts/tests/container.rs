@@ -4,7 +4,7 @@ mod common;
 
 use proptest::prelude::*;
 use proptest::strategy::ValueTree;
-use yarnhom_artifacts::container::{self, decode, encode, frame, header_for, payload_of, Provenance};
+use yarnhom_artifacts::container::{self, Provenance, decode, encode, frame, header_for, payload_of};
 use yarnhom_artifacts::{Artifact, Error, Pattern, YarnModel};
 
 fn sample_pattern() -> Pattern {
@@ -138,7 +138,8 @@ fn writes_are_atomic_and_leave_no_temporary_files() {
     let p = sample_pattern();
     container::write(&path, &p, &Provenance::default()).expect("write");
     container::write(&path, &p, &Provenance::default()).expect("overwrite");
-    let names: Vec<_> = std::fs::read_dir(dir.path()).expect("ls").map(|e| e.expect("entry").file_name()).collect();
+    let names: Vec<_> =
+        std::fs::read_dir(dir.path()).expect("ls").map(|e| e.expect("entry").file_name()).collect();
     assert_eq!(names, vec![std::ffi::OsString::from("x.pattern.yh")]);
     assert_eq!(container::read::<Pattern>(&path).expect("read").1, p);
 }
@@ -158,8 +159,10 @@ fn a_failed_write_keeps_the_old_file() {
 #[test]
 fn the_content_hash_is_the_payload_identity_not_the_file_identity() {
     let p = sample_pattern();
-    let (ha, _) = decode::<Pattern>(&reframed(&p, |h| h.created_utc = "2020-01-01T00:00:00Z".into())).expect("a");
-    let (hb, _) = decode::<Pattern>(&reframed(&p, |h| h.created_utc = "2030-01-01T00:00:00Z".into())).expect("b");
+    let (ha, _) =
+        decode::<Pattern>(&reframed(&p, |h| h.created_utc = "2020-01-01T00:00:00Z".into())).expect("a");
+    let (hb, _) =
+        decode::<Pattern>(&reframed(&p, |h| h.created_utc = "2030-01-01T00:00:00Z".into())).expect("b");
     assert_eq!(ha.content_hash, hb.content_hash);
     let mut q = p.clone();
     q.positions_m[0][0] += 1e-9;

@@ -1,6 +1,6 @@
 //! The committed JSON Schemas in `schemas/` must match the Rust types.
 
-use yarnhom_artifacts::{json_schema, schema, schema_version, KINDS};
+use yarnhom_artifacts::{KINDS, json_schema, schema, schema_version};
 
 const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../schemas");
 const REGENERATE: &str = "regenerate with `cargo run -p yarnhom-cli -- schema --write-all schemas`, \
@@ -23,7 +23,8 @@ fn committed_schemas_match_the_types() {
 
 #[test]
 fn old_schema_versions_stay_committed() {
-    let v0 = serde_json::to_value(schemars::schema_for!(yarnhom_artifacts::yarnmodel::YarnModelV0)).expect("json");
+    let v0 =
+        serde_json::to_value(schemars::schema_for!(yarnhom_artifacts::yarnmodel::YarnModelV0)).expect("json");
     let file = committed("yarnmodel.v0.schema.json");
     assert_eq!(file["properties"], v0["properties"], "the v0 layout must never change");
 }

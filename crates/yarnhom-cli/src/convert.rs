@@ -3,11 +3,11 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use yarnhom_artifacts::{container, AnyArtifact, JsonDocument, Provenance};
+use yarnhom_artifacts::{AnyArtifact, JsonDocument, Provenance, container};
 
-use crate::inputs::{self, base_name, Format, Loaded};
-use crate::pattern::write_text;
 use crate::Outcome;
+use crate::inputs::{self, Format, Loaded, base_name};
+use crate::pattern::write_text;
 
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
@@ -53,7 +53,8 @@ pub fn run(args: ConvertArgs) -> anyhow::Result<Outcome> {
 
 /// Re-encode keeping the original producer and inputs: a conversion changes no content.
 fn write_yh(output: &Path, loaded: &Loaded) -> anyhow::Result<()> {
-    let provenance = Provenance { producer: loaded.header.producer.clone(), inputs: loaded.header.inputs.clone() };
+    let provenance =
+        Provenance { producer: loaded.header.producer.clone(), inputs: loaded.header.inputs.clone() };
     let bytes = loaded.artifact.encode(&provenance)?;
     container::write_atomic(output, &bytes).map_err(|e| e.at(output))?;
     eprintln!("wrote {}", output.display());

@@ -3,10 +3,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use yarnhom_artifacts::diff::{diff, Tolerance};
+use yarnhom_artifacts::diff::{Tolerance, diff};
 
-use crate::inputs;
 use crate::Outcome;
+use crate::inputs;
 
 #[derive(Debug, Args)]
 pub struct DiffArgs {
@@ -15,10 +15,10 @@ pub struct DiffArgs {
     /// Second artifact (any readable format).
     pub b: PathBuf,
     /// Relative tolerance: values are equal if |a - b| <= atol + rtol * |b|.
-    #[arg(long, default_value_t = 1e-9)]
+    #[arg(long, default_value_t = 1e-9, allow_negative_numbers = true)]
     pub rtol: f64,
     /// Absolute tolerance, in each field's SI unit.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub atol: f64,
     /// Print the comparison as JSON.
     #[arg(long)]

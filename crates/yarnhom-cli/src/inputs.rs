@@ -56,17 +56,6 @@ pub struct Loaded {
     pub artifact: AnyArtifact,
 }
 
-impl Loaded {
-    /// This input as a provenance reference for artifacts made from it.
-    pub fn input_ref(&self) -> InputRef {
-        InputRef {
-            kind: self.artifact.kind().into(),
-            content_hash: self.header.content_hash.clone(),
-            path: self.path.display().to_string(),
-        }
-    }
-}
-
 /// File stem without the `.KIND.yh` / `.pyp` / ... suffixes: `rib` for `data/rib.pattern.yh`.
 pub fn base_name(path: &Path) -> String {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -103,11 +92,16 @@ pub fn load(path: &Path, fabric: Option<Fabric>) -> anyhow::Result<Loaded> {
         Format::Pyp => {
             let text = std::str::from_utf8(&bytes)
                 .with_context(|| format!("{}: .pyp is not UTF-8 text", path.display()))?;
-            let pattern = yarnhom_artifacts::pyp::parse_pyp(text, &base_name(path), fabric)
-                .map_err(|e| e.at(path))?;
-            let input = InputRef { kind: "pyp".into(), content_hash: content_hash(&bytes), path: path.display().to_string() };
+            let pattern =
+                yarnhom_artifacts::pyp::parse_pyp(text, &base_name(path), fabric).map_err(|e| e.at(path))?;
+            let input = InputRef {
+                kind: "pyp".into(),
+                content_hash: content_hash(&bytes),
+                path: path.display().to_string(),
+            };
             let payload = container::payload_of(&pattern)?;
-            let header = container::header_for::<Pattern>(&payload, &provenance("pattern import", vec![input]));
+            let header =
+                container::header_for::<Pattern>(&payload, &provenance("pattern import", vec![input]));
             (header, AnyArtifact::Pattern(pattern))
         }
     };

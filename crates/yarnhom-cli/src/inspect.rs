@@ -4,8 +4,8 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::inputs;
 use crate::Outcome;
+use crate::inputs;
 
 #[derive(Debug, Args)]
 pub struct InspectArgs {
@@ -19,7 +19,8 @@ pub struct InspectArgs {
 pub fn run(args: InspectArgs) -> anyhow::Result<Outcome> {
     let loaded = inputs::load(&args.input, None)?;
     if args.json {
-        let doc = yarnhom_artifacts::JsonDocument { header: loaded.header, payload: loaded.artifact.to_json()? };
+        let doc =
+            yarnhom_artifacts::JsonDocument { header: loaded.header, payload: loaded.artifact.to_json()? };
         println!("{}", serde_json::to_string_pretty(&doc)?);
         return Ok(Outcome::Success);
     }

@@ -3,10 +3,10 @@
 use std::path::PathBuf;
 
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::{container, YarnModel};
+use yarnhom_artifacts::{YarnModel, container};
 
-use crate::inputs::provenance;
 use crate::Outcome;
+use crate::inputs::provenance;
 
 #[derive(Debug, Subcommand)]
 pub enum ModelCommand {

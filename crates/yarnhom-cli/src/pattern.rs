@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::{container, AnyArtifact, Fabric, Pattern};
-use yarnhom_pattern::{GeneratorParams, GENERATORS};
+use yarnhom_artifacts::{AnyArtifact, Fabric, Pattern, container};
+use yarnhom_pattern::{GENERATORS, GeneratorParams};
 
-use crate::inputs::{self, base_name, provenance};
 use crate::Outcome;
+use crate::inputs::{self, base_name, provenance};
 
 #[derive(Debug, Subcommand)]
 pub enum PatternCommand {
@@ -32,13 +32,13 @@ pub struct GenerateArgs {
     /// Generator name: stockinette, garter, rib, seed, plain, basket, satin.
     pub name: String,
     /// Stitch width (m): wale spacing for knits, warp yarn spacing for weaves.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub stitch_width_m: Option<f64>,
     /// Stitch height (m): course spacing for knits, weft yarn spacing for weaves.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub stitch_height_m: Option<f64>,
     /// Yarn radius (m).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub radius_m: Option<f64>,
     /// Centreline vertices per stitch (resolution).
     #[arg(long)]
@@ -143,17 +143,25 @@ fn import(args: ImportArgs) -> anyhow::Result<()> {
 fn export(args: ExportArgs) -> anyhow::Result<()> {
     let loaded = inputs::load(&args.input, None)?;
     let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
-        anyhow::bail!("{}: holds a '{}', only patterns export to .pyp", args.input.display(), loaded.artifact.kind())
+        anyhow::bail!(
+            "{}: holds a '{}', only patterns export to .pyp",
+            args.input.display(),
+            loaded.artifact.kind()
+        )
     };
     let text = yarnhom_artifacts::pyp::write_pyp(pattern)?;
     let output = args.output.unwrap_or_else(|| format!("{}.pyp", base_name(&args.input)).into());
     write_text(&output, &text)
 }
 
-fn write_pattern(output: &PathBuf, pattern: &Pattern, provenance: yarnhom_artifacts::Provenance) -> anyhow::Result<()> {
+fn write_pattern(
+    output: &PathBuf,
+    pattern: &Pattern,
+    provenance: yarnhom_artifacts::Provenance,
+) -> anyhow::Result<()> {
     container::write(output, pattern, &provenance)?;
     eprintln!(
-        "wrote {} ({} yarns, {} vertices, {:.3} x {:.3} mm)",
+        "wrote {} ({} yarn(s), {} vertices, {:.3} x {:.3} mm)",
         output.display(),
         pattern.yarns.len(),
         pattern.vertex_count(),

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use yarnhom_artifacts::{json_schema, schema, schema_version, KINDS};
+use yarnhom_artifacts::{KINDS, json_schema, schema, schema_version};
 
 use crate::Outcome;
 

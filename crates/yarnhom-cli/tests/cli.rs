@@ -48,7 +48,14 @@ fn import_and_inspect_show_the_published_rib() {
     let out = rib(dir.path());
     let text = ok(&["inspect", out.to_str().expect("utf8")], dir.path());
     // The published header: px py radius n = 0.0174261 0.0116613 0.001001 356.
-    for expected in ["kind: pattern v1", "17.4261 mm x 11.6613 mm", "vertices: 356", "yarn radius: 1.0010 mm", "knit fabric", "rest state: yes"] {
+    for expected in [
+        "kind: pattern v1",
+        "17.4261 mm x 11.6613 mm",
+        "vertices: 356",
+        "yarn radius: 1.0010 mm",
+        "knit fabric",
+        "rest state: yes",
+    ] {
         assert!(text.contains(expected), "missing '{expected}' in:\n{text}");
     }
     assert!(text.contains("input: pyp sha256:"), "provenance of the .pyp missing:\n{text}");
@@ -121,7 +128,10 @@ fn conversions_are_lossless() {
         let out = dir.path().join(file);
         ok(&["convert", a, "--to", format, "-o", out.to_str().expect("utf8")], dir.path());
         let back = dir.path().join(format!("back-{format}.pattern.yh"));
-        ok(&["convert", out.to_str().expect("utf8"), "--to", "yh", "-o", back.to_str().expect("utf8")], dir.path());
+        ok(
+            &["convert", out.to_str().expect("utf8"), "--to", "yh", "-o", back.to_str().expect("utf8")],
+            dir.path(),
+        );
         let o = yarnhom(&["diff", a, back.to_str().expect("utf8"), "--rtol", "0"], dir.path());
         assert_eq!(o.status.code(), Some(0), "{format}: {}", stdout(&o));
     }
@@ -156,7 +166,8 @@ fn yarn_models_and_schemas() {
     let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/yarnmodel.v0.yh");
     assert!(ok(&["inspect", fixture], dir.path()).contains("read through migration to v1"));
     for kind in yarnhom_artifacts::KINDS {
-        let schema: serde_json::Value = serde_json::from_str(&ok(&["schema", kind], dir.path())).expect("JSON");
+        let schema: serde_json::Value =
+            serde_json::from_str(&ok(&["schema", kind], dir.path())).expect("JSON");
         assert_eq!(schema["$id"], format!("yarnhom:{kind}.v1"));
     }
     fails_with(&["schema", "teapot"], dir.path(), "unknown artifact kind 'teapot'");
@@ -167,9 +178,19 @@ fn yarn_models_and_schemas() {
 fn every_command_explains_itself() {
     let dir = tempfile::tempdir().expect("tempdir");
     let commands: &[&[&str]] = &[
-        &[], &["pattern"], &["pattern", "list"], &["pattern", "generate"], &["pattern", "import"],
-        &["pattern", "export"], &["model"], &["model", "list"], &["model", "write"], &["inspect"],
-        &["convert"], &["schema"], &["diff"],
+        &[],
+        &["pattern"],
+        &["pattern", "list"],
+        &["pattern", "generate"],
+        &["pattern", "import"],
+        &["pattern", "export"],
+        &["model"],
+        &["model", "list"],
+        &["model", "write"],
+        &["inspect"],
+        &["convert"],
+        &["schema"],
+        &["diff"],
     ];
     for cmd in commands {
         let mut args = cmd.to_vec();

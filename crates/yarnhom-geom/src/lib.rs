@@ -3,4 +3,4 @@
 
 pub mod segment;
 
-pub use segment::{segment_crossing_2d, segment_distance, SegmentDistance};
+pub use segment::{SegmentDistance, segment_crossing_2d, segment_distance};

@@ -40,7 +40,8 @@ pub fn segment_distance(
             let b = d1.dot(&d2);
             let denom = a * e - b * b;
             // Parallel segments (denom ~ 0): any s works; take s = 0 and let t follow.
-            let mut s = if denom > f64::EPSILON * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
+            let mut s =
+                if denom > f64::EPSILON * a * e { ((b * f - c * e) / denom).clamp(0.0, 1.0) } else { 0.0 };
             let mut t = (b * s + f) / e;
             if t < 0.0 {
                 t = 0.0;
@@ -100,7 +101,8 @@ mod tests {
 
     #[test]
     fn crossing_perpendicular_segments_are_their_offset_apart() {
-        let d = segment_distance(&v(-1.0, 0.0, 0.0), &v(1.0, 0.0, 0.0), &v(0.0, -1.0, 2.0), &v(0.0, 1.0, 2.0));
+        let d =
+            segment_distance(&v(-1.0, 0.0, 0.0), &v(1.0, 0.0, 0.0), &v(0.0, -1.0, 2.0), &v(0.0, 1.0, 2.0));
         assert!((d.distance - 2.0).abs() < 1e-15);
         assert!((d.s - 0.5).abs() < 1e-15 && (d.t - 0.5).abs() < 1e-15);
     }
@@ -124,11 +126,32 @@ mod tests {
 
     #[test]
     fn planar_crossings() {
-        let c = segment_crossing_2d(&Vector2::new(0.0, 0.0), &Vector2::new(2.0, 0.0), &Vector2::new(0.5, -1.0), &Vector2::new(0.5, 3.0));
+        let c = segment_crossing_2d(
+            &Vector2::new(0.0, 0.0),
+            &Vector2::new(2.0, 0.0),
+            &Vector2::new(0.5, -1.0),
+            &Vector2::new(0.5, 3.0),
+        );
         let (s, t) = c.expect("they cross");
         assert!((s - 0.25).abs() < 1e-15 && (t - 0.25).abs() < 1e-15);
-        assert!(segment_crossing_2d(&Vector2::new(0.0, 0.0), &Vector2::new(1.0, 0.0), &Vector2::new(0.0, 1.0), &Vector2::new(1.0, 1.0)).is_none());
-        assert!(segment_crossing_2d(&Vector2::new(0.0, 0.0), &Vector2::new(1.0, 0.0), &Vector2::new(2.0, -1.0), &Vector2::new(2.0, 1.0)).is_none());
+        assert!(
+            segment_crossing_2d(
+                &Vector2::new(0.0, 0.0),
+                &Vector2::new(1.0, 0.0),
+                &Vector2::new(0.0, 1.0),
+                &Vector2::new(1.0, 1.0)
+            )
+            .is_none()
+        );
+        assert!(
+            segment_crossing_2d(
+                &Vector2::new(0.0, 0.0),
+                &Vector2::new(1.0, 0.0),
+                &Vector2::new(2.0, -1.0),
+                &Vector2::new(2.0, 1.0)
+            )
+            .is_none()
+        );
     }
 
     proptest! {

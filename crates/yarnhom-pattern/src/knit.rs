@@ -23,7 +23,7 @@ use yarnhom_artifacts::{Fabric, Pattern};
 use yarnhom_geom::segment_crossing_2d;
 
 use crate::curve::{arc_lengths, periodic_bspline, resample, undulate};
-use crate::{add_yarn, GenerateError, GeneratorParams};
+use crate::{GenerateError, GeneratorParams, add_yarn};
 
 /// Knit or purl, as seen from the front (+X3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -14,7 +14,7 @@ pub mod weave;
 use yarnhom_artifacts::{Fabric, Pattern, Yarn};
 
 use knit::Stitch::{Knit as K, Purl as P};
-pub use min_distance::{min_inter_yarn_distance, EdgeRef, MinDistance};
+pub use min_distance::{EdgeRef, MinDistance, min_inter_yarn_distance};
 
 /// A generator's size and resolution parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,13 +65,48 @@ pub struct GeneratorInfo {
 
 /// Every built-in generator.
 pub const GENERATORS: &[GeneratorInfo] = &[
-    GeneratorInfo { name: "stockinette", fabric: Fabric::Knit, description: "jersey: knit stitches only; 1 wale x 1 course tile", build: |n, p| knit::knit(n, &[vec![K]], p) },
-    GeneratorInfo { name: "garter", fabric: Fabric::Knit, description: "knit and purl courses alternating; 1 x 2 tile", build: |n, p| knit::knit(n, &[vec![K], vec![P]], p) },
-    GeneratorInfo { name: "rib", fabric: Fabric::Knit, description: "1x1 rib: knit and purl wales alternating; 2 x 1 tile", build: |n, p| knit::knit(n, &[vec![K, P]], p) },
-    GeneratorInfo { name: "seed", fabric: Fabric::Knit, description: "knit/purl checkerboard; 2 x 2 tile", build: |n, p| knit::knit(n, &[vec![K, P], vec![P, K]], p) },
-    GeneratorInfo { name: "plain", fabric: Fabric::Woven, description: "plain (tabby) weave, 1/1; 2 warps x 2 wefts", build: |n, p| weave::weave(n, &interlacing(2, |i, j| (i + j) % 2 == 0), p) },
-    GeneratorInfo { name: "basket", fabric: Fabric::Woven, description: "2x2 basket weave; 4 warps x 4 wefts", build: |n, p| weave::weave(n, &interlacing(4, |i, j| (i / 2 + j / 2) % 2 == 0), p) },
-    GeneratorInfo { name: "satin", fabric: Fabric::Woven, description: "5-harness satin (warp floats over 4, step 2); 5 x 5", build: |n, p| weave::weave(n, &interlacing(5, |i, j| (2 * i + 5 - j % 5) % 5 != 0), p) },
+    GeneratorInfo {
+        name: "stockinette",
+        fabric: Fabric::Knit,
+        description: "jersey: knit stitches only; 1 wale x 1 course tile",
+        build: |n, p| knit::knit(n, &[vec![K]], p),
+    },
+    GeneratorInfo {
+        name: "garter",
+        fabric: Fabric::Knit,
+        description: "knit and purl courses alternating; 1 x 2 tile",
+        build: |n, p| knit::knit(n, &[vec![K], vec![P]], p),
+    },
+    GeneratorInfo {
+        name: "rib",
+        fabric: Fabric::Knit,
+        description: "1x1 rib: knit and purl wales alternating; 2 x 1 tile",
+        build: |n, p| knit::knit(n, &[vec![K, P]], p),
+    },
+    GeneratorInfo {
+        name: "seed",
+        fabric: Fabric::Knit,
+        description: "knit/purl checkerboard; 2 x 2 tile",
+        build: |n, p| knit::knit(n, &[vec![K, P], vec![P, K]], p),
+    },
+    GeneratorInfo {
+        name: "plain",
+        fabric: Fabric::Woven,
+        description: "plain (tabby) weave, 1/1; 2 warps x 2 wefts",
+        build: |n, p| weave::weave(n, &interlacing(2, |i, j| (i + j) % 2 == 0), p),
+    },
+    GeneratorInfo {
+        name: "basket",
+        fabric: Fabric::Woven,
+        description: "2x2 basket weave; 4 warps x 4 wefts",
+        build: |n, p| weave::weave(n, &interlacing(4, |i, j| (i / 2 + j / 2) % 2 == 0), p),
+    },
+    GeneratorInfo {
+        name: "satin",
+        fabric: Fabric::Woven,
+        description: "5-harness satin (warp floats over 4, step 2); 5 x 5",
+        build: |n, p| weave::weave(n, &interlacing(5, |i, j| (2 * i + 5 - j % 5) % 5 != 0), p),
+    },
 ];
 
 impl GeneratorParams {
@@ -82,15 +117,29 @@ impl GeneratorParams {
     pub fn defaults_for(name: &str) -> Result<GeneratorParams, GenerateError> {
         let info = info(name)?;
         Ok(match info.fabric {
-            Fabric::Knit => GeneratorParams { stitch_width_m: 0.015, stitch_height_m: 0.008, yarn_radius_m: 0.001, vertices_per_stitch: 40 },
-            Fabric::Woven => GeneratorParams { stitch_width_m: 0.004, stitch_height_m: 0.004, yarn_radius_m: 0.001, vertices_per_stitch: 8 },
+            Fabric::Knit => GeneratorParams {
+                stitch_width_m: 0.015,
+                stitch_height_m: 0.008,
+                yarn_radius_m: 0.001,
+                vertices_per_stitch: 40,
+            },
+            Fabric::Woven => GeneratorParams {
+                stitch_width_m: 0.004,
+                stitch_height_m: 0.004,
+                yarn_radius_m: 0.001,
+                vertices_per_stitch: 8,
+            },
         })
     }
 
     /// Check that the values are usable and the stitch holds at least `min_width x min_height`.
     fn require_stitch(&self, min_width: f64, min_height: f64) -> Result<(), GenerateError> {
         let bad = |m: String| Err(GenerateError::BadParameter(m));
-        for (name, v) in [("stitch width", self.stitch_width_m), ("stitch height", self.stitch_height_m), ("yarn radius", self.yarn_radius_m)] {
+        for (name, v) in [
+            ("stitch width", self.stitch_width_m),
+            ("stitch height", self.stitch_height_m),
+            ("yarn radius", self.yarn_radius_m),
+        ] {
             if !(v.is_finite() && v > 0.0) {
                 return bad(format!("{name} must be a finite length > 0 m, got {v}"));
             }
@@ -115,7 +164,9 @@ fn info(name: &str) -> Result<&'static GeneratorInfo, GenerateError> {
 /// Run the generator `name`.
 pub fn generate(name: &str, params: &GeneratorParams) -> Result<Pattern, GenerateError> {
     let pattern = (info(name)?.build)(name, params)?;
-    pattern.validate().map_err(|e| GenerateError::BadParameter(format!("generated pattern is invalid: {e}")))?;
+    pattern
+        .validate()
+        .map_err(|e| GenerateError::BadParameter(format!("generated pattern is invalid: {e}")))?;
     Ok(pattern)
 }
 
@@ -125,7 +176,12 @@ fn interlacing(n: usize, over: impl Fn(usize, usize) -> bool) -> Vec<Vec<bool>> 
 }
 
 /// Append a yarn through `points` (closing with tile offset `closure`) to `positions`.
-fn add_yarn(positions: &mut Vec<[f64; 3]>, points: impl Iterator<Item = [f64; 3]>, closure: [i32; 2], r: f64) -> Yarn {
+fn add_yarn(
+    positions: &mut Vec<[f64; 3]>,
+    points: impl Iterator<Item = [f64; 3]>,
+    closure: [i32; 2],
+    r: f64,
+) -> Yarn {
     let start = positions.len() as u32;
     positions.extend(points);
     let n = positions.len() - start as usize;

@@ -53,11 +53,13 @@ pub fn same_yarn_exclusion(radius_m: f64) -> f64 {
 /// [`same_yarn_exclusion`] along the yarn are skipped. `None` for a pattern with no such pair.
 pub fn min_inter_yarn_distance(pattern: &Pattern) -> Option<MinDistance> {
     let segments = segments(pattern);
-    let lengths: Vec<f64> = pattern.yarns.iter().enumerate().map(|(y, _)| yarn_length(&segments, y)).collect();
+    let lengths: Vec<f64> =
+        pattern.yarns.iter().enumerate().map(|(y, _)| yarn_length(&segments, y)).collect();
     let mut best: Option<MinDistance> = None;
     for ox in -1..=1 {
         for oy in -1..=1 {
-            let shift = Vector3::new(f64::from(ox) * pattern.period_m[0], f64::from(oy) * pattern.period_m[1], 0.0);
+            let shift =
+                Vector3::new(f64::from(ox) * pattern.period_m[0], f64::from(oy) * pattern.period_m[1], 0.0);
             for a in &segments {
                 for b in &segments {
                     if ox == 0 && oy == 0 && (b.yarn, b.index) <= (a.yarn, a.index) {

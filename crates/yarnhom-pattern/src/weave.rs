@@ -6,7 +6,7 @@
 use yarnhom_artifacts::{Fabric, Pattern};
 
 use crate::curve::{resample, undulate};
-use crate::{add_yarn, GenerateError, GeneratorParams};
+use crate::{GenerateError, GeneratorParams, add_yarn};
 
 /// Height of the crossings above and below the mid-plane, in radii.
 const LEVEL_R: f64 = 1.05;
@@ -31,10 +31,18 @@ pub fn weave(name: &str, warp_over: &[Vec<bool>], p: &GeneratorParams) -> Result
     let mut yarns = Vec::new();
     for (j, row) in warp_over.iter().enumerate() {
         let y = centre(j, p.stitch_height_m, period[1]);
-        let levels: Vec<(f64, f64)> =
-            row.iter().enumerate().map(|(i, &over)| (centre(i, p.stitch_width_m, 0.0), if over { -1.0 } else { 1.0 })).collect();
+        let levels: Vec<(f64, f64)> = row
+            .iter()
+            .enumerate()
+            .map(|(i, &over)| (centre(i, p.stitch_width_m, 0.0), if over { -1.0 } else { 1.0 }))
+            .collect();
         let path = straight_yarn(&levels, period[0], warps * p.vertices_per_stitch, r);
-        yarns.push(add_yarn(&mut positions, path.iter().map(|&(x, z)| [x - period[0] / 2.0, y, z]), [1, 0], r));
+        yarns.push(add_yarn(
+            &mut positions,
+            path.iter().map(|&(x, z)| [x - period[0] / 2.0, y, z]),
+            [1, 0],
+            r,
+        ));
     }
     for i in 0..warps {
         let x = centre(i, p.stitch_width_m, period[0]);
@@ -44,7 +52,12 @@ pub fn weave(name: &str, warp_over: &[Vec<bool>], p: &GeneratorParams) -> Result
             .map(|(j, row)| (centre(j, p.stitch_height_m, 0.0), if row[i] { 1.0 } else { -1.0 }))
             .collect();
         let path = straight_yarn(&levels, period[1], wefts * p.vertices_per_stitch, r);
-        yarns.push(add_yarn(&mut positions, path.iter().map(|&(y, z)| [x, y - period[1] / 2.0, z]), [0, 1], r));
+        yarns.push(add_yarn(
+            &mut positions,
+            path.iter().map(|&(y, z)| [x, y - period[1] / 2.0, z]),
+            [0, 1],
+            r,
+        ));
     }
     Ok(Pattern {
         name: name.into(),

@@ -1,7 +1,7 @@
 //! Every generator makes a valid, non-interpenetrating tile with the structure its name promises.
 
 use yarnhom_artifacts::{Fabric, Pattern};
-use yarnhom_pattern::{generate, min_inter_yarn_distance, GenerateError, GeneratorParams, GENERATORS};
+use yarnhom_pattern::{GENERATORS, GenerateError, GeneratorParams, generate, min_inter_yarn_distance};
 
 const KNITS: [&str; 4] = ["stockinette", "garter", "rib", "seed"];
 const WEAVES: [&str; 3] = ["plain", "basket", "satin"];
@@ -46,7 +46,13 @@ fn yarns_stay_at_least_1_9_radii_apart() {
         for p in variants(g.name) {
             let r = p.yarns[0].radius_m;
             let m = min_inter_yarn_distance(&p).expect("tiles have neighbouring yarns");
-            assert!(m.distance_m >= 1.9 * r, "{}: centrelines {:.3} r apart at {m:?} ({})", g.name, m.distance_m / r, p.origin);
+            assert!(
+                m.distance_m >= 1.9 * r,
+                "{}: centrelines {:.3} r apart at {m:?} ({})",
+                g.name,
+                m.distance_m / r,
+                p.origin
+            );
         }
     }
 }
@@ -86,7 +92,11 @@ fn edges_are_near_uniform_and_shorter_than_the_radius_scale() {
         let l = edge_lengths(&p);
         let (lo, hi) = l.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
         assert!(hi / lo < 1.5, "{}: edge lengths {lo:.2e}..{hi:.2e}", g.name);
-        assert!(hi < 2.0 * p.yarns[0].radius_m, "{}: edges of {hi:.2e} m are coarse against the radius", g.name);
+        assert!(
+            hi < 2.0 * p.yarns[0].radius_m,
+            "{}: edges of {hi:.2e} m are coarse against the radius",
+            g.name
+        );
     }
 }
 
@@ -105,7 +115,10 @@ fn knitted_courses_form_loops_and_woven_yarns_do_not() {
         let p = make(name, |_| {});
         for (i, y) in p.yarns.iter().enumerate() {
             let axis = if y.closure_offset() == [1, 0] { 0 } else { 1 };
-            assert!(p.edges().filter(|e| e.yarn == i).all(|e| p.edge_vector(&e)[axis] > 0.0), "{name}: yarn {i} turns back");
+            assert!(
+                p.edges().filter(|e| e.yarn == i).all(|e| p.edge_vector(&e)[axis] > 0.0),
+                "{name}: yarn {i} turns back"
+            );
         }
     }
 }
@@ -169,7 +182,10 @@ fn distance_to_yarn(p: &Pattern, yarn: usize, points: &[[f64; 3]]) -> f64 {
         .iter()
         .map(|x| {
             let x = Vector3::from(*x);
-            segments.iter().map(|(a, b)| yarnhom_geom::segment_distance(&x, &x, a, b).distance).fold(f64::INFINITY, f64::min)
+            segments
+                .iter()
+                .map(|(a, b)| yarnhom_geom::segment_distance(&x, &x, a, b).distance)
+                .fold(f64::INFINITY, f64::min)
         })
         .fold(0.0, f64::max)
 }
@@ -187,8 +203,12 @@ fn a_purl_wale_is_a_knit_wale_mirrored() {
     // Garter: the purl course is the knit course mirrored and moved up one course.
     let garter = make("garter", |_| {});
     let h = garter.period_m[1] / 2.0;
-    let knit_course: Vec<[f64; 3]> =
-        garter.yarns[0].vertices.iter().map(|&v| garter.positions_m[v as usize]).map(|x| [x[0], x[1] + h, -x[2]]).collect();
+    let knit_course: Vec<[f64; 3]> = garter.yarns[0]
+        .vertices
+        .iter()
+        .map(|&v| garter.positions_m[v as usize])
+        .map(|x| [x[0], x[1] + h, -x[2]])
+        .collect();
     let off = distance_to_yarn(&garter, 1, &knit_course);
     assert!(off < 0.05 * r, "mirrored garter course is {:.3} r off the purl course", off / r);
 }
@@ -201,7 +221,11 @@ fn the_smallest_allowed_stitches_still_do_not_interpenetrate() {
             p.stitch_height_m = yarnhom_pattern::knit::MIN_HEIGHT_R * p.yarn_radius_m;
         });
         let m = min_inter_yarn_distance(&p).expect("pairs");
-        assert!(m.distance_m >= 1.9 * p.yarns[0].radius_m, "{name}: {:.3} r", m.distance_m / p.yarns[0].radius_m);
+        assert!(
+            m.distance_m >= 1.9 * p.yarns[0].radius_m,
+            "{name}: {:.3} r",
+            m.distance_m / p.yarns[0].radius_m
+        );
     }
     for name in WEAVES {
         let p = make(name, |p| {
@@ -209,7 +233,11 @@ fn the_smallest_allowed_stitches_still_do_not_interpenetrate() {
             p.stitch_height_m = p.stitch_width_m;
         });
         let m = min_inter_yarn_distance(&p).expect("pairs");
-        assert!(m.distance_m >= 1.9 * p.yarns[0].radius_m, "{name}: {:.3} r", m.distance_m / p.yarns[0].radius_m);
+        assert!(
+            m.distance_m >= 1.9 * p.yarns[0].radius_m,
+            "{name}: {:.3} r",
+            m.distance_m / p.yarns[0].radius_m
+        );
     }
 }
 
@@ -232,9 +260,13 @@ fn bad_parameters_are_errors_not_panics() {
 }
 
 fn published(name: &str) -> Option<Pattern> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-patterns/").to_string() + name + ".pyp";
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-patterns/").to_string()
+        + name
+        + ".pyp";
     match std::fs::read_to_string(&path) {
-        Ok(text) => Some(yarnhom_artifacts::pyp::parse_pyp(&text, name, None).expect("published pattern imports")),
+        Ok(text) => {
+            Some(yarnhom_artifacts::pyp::parse_pyp(&text, name, None).expect("published pattern imports"))
+        }
         Err(e) => {
             println!("SKIPPED: {path}: {e}");
             None

@@ -23,14 +23,28 @@ pub fn pattern() -> impl Strategy<Value = Pattern> {
         .prop_flat_map(|(shape, px, py, radius, with_rest, knit)| {
             let n: usize = shape.iter().sum();
             let positions = prop::collection::vec(
-                (finite(-px / 2.0, px / 2.0), finite(-py / 2.0, py / 2.0), finite(-radius * 3.0, radius * 3.0))
+                (
+                    finite(-px / 2.0, px / 2.0),
+                    finite(-py / 2.0, py / 2.0),
+                    finite(-radius * 3.0, radius * 3.0),
+                )
                     .prop_map(|(x, y, z)| [x, y, z]),
                 n,
             );
             let twists = prop::collection::vec(finite(-3.0, 3.0), n);
             let offsets = prop::collection::vec((-1i32..=1, -1i32..=1).prop_map(|(a, b)| [a, b]), n);
             let rest = rest_state(n);
-            (Just(shape), Just([px, py]), Just(radius), positions, twists, offsets, rest, Just(with_rest), Just(knit))
+            (
+                Just(shape),
+                Just([px, py]),
+                Just(radius),
+                positions,
+                twists,
+                offsets,
+                rest,
+                Just(with_rest),
+                Just(knit),
+            )
         })
         .prop_map(|(shape, period, radius, positions, twists, offsets, rest, with_rest, knit)| {
             let mut yarns = Vec::new();
@@ -39,7 +53,8 @@ pub fn pattern() -> impl Strategy<Value = Pattern> {
                 let mut edge_offsets = offsets[start..start + len].to_vec();
                 let sum = edge_offsets.iter().fold([0, 0], |a, o| [a[0] + o[0], a[1] + o[1]]);
                 if sum == [0, 0] {
-                    edge_offsets[len - 1][0] = if edge_offsets[len - 1][0] == 1 { 0 } else { edge_offsets[len - 1][0] + 1 };
+                    edge_offsets[len - 1][0] =
+                        if edge_offsets[len - 1][0] == 1 { 0 } else { edge_offsets[len - 1][0] + 1 };
                 }
                 yarns.push(Yarn {
                     radius_m: radius,
@@ -85,10 +100,23 @@ fn rest_state(n: usize) -> impl Strategy<Value = RestState> {
 
 /// A valid yarn model of either family.
 pub fn yarn_model() -> impl Strategy<Value = YarnModel> {
-    let rod = (finite(1e3, 1e9), finite(1e3, 1e9), finite(1e-4, 10.0), finite(1e-1, 1e4)).prop_map(|(e, g, gamma, k)| {
-        YarnMechanics::ElasticRod { youngs_modulus_pa: e, shear_modulus_pa: g, gamma, contact_stiffness_kg_s2: k }
-    });
-    let biphasic = (finite(1e-3, 1.0), finite(1.0, 1e3), finite(0.0, 0.2), finite(1e-12, 1e-6), finite(1e-4, 1e-3), finite(1e-2, 1e2), finite(1e-2, 1e3))
+    let rod = (finite(1e3, 1e9), finite(1e3, 1e9), finite(1e-4, 10.0), finite(1e-1, 1e4)).prop_map(
+        |(e, g, gamma, k)| YarnMechanics::ElasticRod {
+            youngs_modulus_pa: e,
+            shear_modulus_pa: g,
+            gamma,
+            contact_stiffness_kg_s2: k,
+        },
+    );
+    let biphasic = (
+        finite(1e-3, 1.0),
+        finite(1.0, 1e3),
+        finite(0.0, 0.2),
+        finite(1e-12, 1e-6),
+        finite(1e-4, 1e-3),
+        finite(1e-2, 1e2),
+        finite(1e-2, 1e3),
+    )
         .prop_map(|(f1, ks2, eps, kb, r1, kc1, kc2)| YarnMechanics::Biphasic {
             k_s1_n: f1 * ks2,
             k_s2_n: ks2,
@@ -99,10 +127,7 @@ pub fn yarn_model() -> impl Strategy<Value = YarnModel> {
             r2_m: 0.25 * r1,
             k_c2_n_m: kc2,
         });
-    (finite(1e-5, 1e-2), finite(10.0, 2e3), prop_oneof![rod, biphasic]).prop_map(|(r, rho, mechanics)| YarnModel {
-        name: "random".into(),
-        radius_m: r,
-        density_kg_m3: rho,
-        mechanics,
+    (finite(1e-5, 1e-2), finite(10.0, 2e3), prop_oneof![rod, biphasic]).prop_map(|(r, rho, mechanics)| {
+        YarnModel { name: "random".into(), radius_m: r, density_kg_m3: rho, mechanics }
     })
 }
