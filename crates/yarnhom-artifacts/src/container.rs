@@ -132,7 +132,7 @@ pub fn header_for<T: Artifact>(payload: &[u8], provenance: &Provenance) -> Heade
 
 /// Validate and encode an artifact into container bytes.
 pub fn encode<T: Artifact>(value: &T, provenance: &Provenance) -> Result<Vec<u8>> {
-    value.validate().map_err(|source| Error::Invalid { kind: T::KIND, source })?;
+    value.validate().map_err(|problem| Error::Invalid { kind: T::KIND, problem })?;
     let payload = payload_of(value)?;
     frame(&header_for::<T>(&payload, provenance), &payload)
 }
@@ -268,7 +268,7 @@ pub fn decode_payload<T: Artifact>(raw: &RawArtifact) -> Result<T> {
             .map_err(|e| Error::Decode { what: T::KIND, message: e.to_string() })?,
         std::cmp::Ordering::Less => T::migrate(h.schema_version, &raw.payload)?,
     };
-    value.validate().map_err(|source| Error::Invalid { kind: T::KIND, source })?;
+    value.validate().map_err(|problem| Error::Invalid { kind: T::KIND, problem })?;
     Ok(value)
 }
 

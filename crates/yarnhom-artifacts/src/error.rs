@@ -107,12 +107,12 @@ pub enum Error {
         message: String,
     },
     /// The decoded value breaks an invariant of its kind.
-    #[error("invalid {kind}: {source}")]
+    #[error("invalid {kind}: {problem}")]
     Invalid {
         /// Artifact kind.
         kind: &'static str,
-        /// What is wrong.
-        source: ValidationError,
+        /// What is wrong (shown inline, so not exposed as `source()`).
+        problem: ValidationError,
     },
     /// A problem in a foreign format (`.pyp`, ARCSim JSON, ...), with its line.
     #[error("{format} line {line}: {message}")]
@@ -136,12 +136,12 @@ pub enum Error {
     #[error("hdf5: {0}")]
     Hdf5(String),
     /// Any of the above, with the file it concerns.
-    #[error("{}: {source}", path.display())]
+    #[error("{}: {error}", path.display())]
     At {
         /// The file.
         path: PathBuf,
-        /// The problem.
-        source: Box<Error>,
+        /// The problem (shown inline, so not exposed as `source()`).
+        error: Box<Error>,
     },
 }
 
@@ -150,14 +150,14 @@ impl Error {
     pub fn at(self, path: impl Into<PathBuf>) -> Self {
         match self {
             Error::At { .. } => self,
-            other => Error::At { path: path.into(), source: Box::new(other) },
+            other => Error::At { path: path.into(), error: Box::new(other) },
         }
     }
 
     /// The error without its file location.
     pub fn root(&self) -> &Error {
         match self {
-            Error::At { source, .. } => source.root(),
+            Error::At { error, .. } => error.root(),
             other => other,
         }
     }

@@ -163,7 +163,7 @@ pub fn import(path: &Path) -> Result<(Header, AnyArtifact)> {
 // Export
 
 fn export_pattern(path: &Path, header: &Header, p: &Pattern) -> Result<()> {
-    p.validate().map_err(|source| Error::Invalid { kind: Pattern::KIND, source })?;
+    p.validate().map_err(|problem| Error::Invalid { kind: Pattern::KIND, problem })?;
     let content_hash = container::content_hash(&container::payload_of(p)?);
     let inputs = serde_json::to_string(&header.inputs)
         .map_err(|e| Error::Encode { what: "inputs", message: e.to_string() })?;
@@ -370,7 +370,7 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
         rest,
         origin,
     };
-    pattern.validate().map_err(|source| Error::Invalid { kind: Pattern::KIND, source })?;
+    pattern.validate().map_err(|problem| Error::Invalid { kind: Pattern::KIND, problem })?;
     let payload = container::payload_of(&pattern)?;
     let computed = container::content_hash(&payload);
     if computed != stored_hash {
@@ -392,7 +392,7 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
 fn csr_ranges(start: &[u64], n: usize) -> Result<Vec<std::ops::Range<usize>>> {
     let bad = |problem: String| Error::Invalid {
         kind: Pattern::KIND,
-        source: ValidationError::new(YARN_START.path, problem),
+        problem: ValidationError::new(YARN_START.path, problem),
     };
     let (Some(&first), Some(&last)) = (start.first(), start.last()) else {
         return Err(bad("is empty; it needs one entry more than there are yarns".into()));

@@ -124,7 +124,7 @@ pub fn parse_pyp(text: &str, name: &str, fabric: Option<Fabric>) -> Result<Patte
     if fabric.is_none() {
         pattern.fabric = pattern.infer_fabric();
     }
-    pattern.validate().map_err(|source| Error::Invalid { kind: "pattern", source })?;
+    pattern.validate().map_err(|problem| Error::Invalid { kind: "pattern", problem })?;
     Ok(pattern)
 }
 

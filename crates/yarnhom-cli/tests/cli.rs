@@ -33,7 +33,7 @@ fn fails_with(args: &[&str], cwd: &Path, problem: &str) {
     assert_eq!(o.status.code(), Some(2), "yarnhom {args:?}: {err}");
     assert!(!err.contains("panicked"), "yarnhom {args:?} panicked: {err}");
     assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
-    assert!(err.contains(problem), "yarnhom {args:?}: expected '{problem}' in: {err}");
+    assert_eq!(err.matches(problem).count(), 1, "yarnhom {args:?}: expected '{problem}' once in: {err}");
 }
 
 fn rib(dir: &Path) -> PathBuf {
