@@ -72,7 +72,7 @@ fn damaged_files_give_one_line_errors_and_exit_2() {
         p.to_str().expect("utf8").to_string()
     };
     let truncated = write("truncated.pattern.yh", &bytes[..bytes.len() - 100]);
-    fails_with(&["inspect", &truncated], dir.path(), "truncated");
+    fails_with(&["inspect", &truncated], dir.path(), "truncated file");
     let mut flipped = bytes.clone();
     flipped[bytes.len() / 2] ^= 0x10;
     let flipped = write("flipped.pattern.yh", &flipped);
@@ -89,7 +89,7 @@ fn damaged_files_give_one_line_errors_and_exit_2() {
     let newer_container = write("container.pattern.yh", &newer_container);
     fails_with(&["inspect", &newer_container], dir.path(), "container version 2 is newer");
     let garbage = write("garbage.pattern.yh", b"\x89YHOM\r\n\x1a\x01\x00\xff\xff\xff\xff");
-    fails_with(&["diff", &garbage, &truncated], dir.path(), "truncated");
+    fails_with(&["diff", &garbage, &truncated], dir.path(), "truncated file");
     fails_with(&["inspect", "does-not-exist.yh"], dir.path(), "does-not-exist.yh");
     let text = write("notes.txt", b"hello");
     fails_with(&["convert", &text, "--to", "json"], dir.path(), "not a yarnhom artifact");
