@@ -165,6 +165,16 @@ fn yarn_models_and_schemas() {
     fails_with(&["model", "write", "table4.1:argyle"], dir.path(), "unknown yarn model");
     let fixture = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/yarnmodel.v0.yh");
     assert!(ok(&["inspect", fixture], dir.path()).contains("read through migration to v1"));
+    // `convert --to yh` upgrades an old file to the current version, keeping its content.
+    let upgraded = dir.path().join("upgraded.yarnmodel.yh");
+    ok(&["convert", fixture, "--to", "yh", "-o", upgraded.to_str().expect("utf8")], dir.path());
+    assert!(ok(&["inspect", upgraded.to_str().expect("utf8")], dir.path()).contains("kind: yarnmodel v1\n"));
+    assert_eq!(
+        yarnhom(&["diff", fixture, upgraded.to_str().expect("utf8"), "--rtol", "0"], dir.path())
+            .status
+            .code(),
+        Some(0)
+    );
     for kind in yarnhom_artifacts::KINDS {
         let schema: serde_json::Value =
             serde_json::from_str(&ok(&["schema", kind], dir.path())).expect("JSON");
