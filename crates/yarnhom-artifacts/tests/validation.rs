@@ -42,7 +42,8 @@ fn the_reference_tile_is_valid() {
 
 #[test]
 fn each_broken_invariant_is_named() {
-    let cases: Vec<(Box<dyn FnOnce(&mut Pattern)>, &str)> = vec![
+    type Edit = Box<dyn FnOnce(&mut Pattern)>;
+    let cases: Vec<(Edit, &str)> = vec![
         (Box::new(|p| p.period_m[1] = 0.0), "period_m[1]"),
         (Box::new(|p| p.positions_m[2][1] = f64::INFINITY), "positions_m[2][1]: not a finite number"),
         (Box::new(|p| p.edge_twist_rad.push(0.0)), "edge_twist_rad: has 5 entries but there are 4 vertices"),
