@@ -40,5 +40,25 @@ pub fn run(args: InspectArgs) -> anyhow::Result<Outcome> {
         println!("input: {} {} ({})", input.kind, input.content_hash, input.path);
     }
     println!("{}", loaded.artifact.summary());
+    if let yarnhom_artifacts::AnyArtifact::Pattern(p) = &loaded.artifact {
+        println!("  {}", closest_yarns(p));
+    }
     Ok(Outcome::Success)
+}
+
+/// Where the yarn centrelines come closest (in radii): about 2 for touching yarns, well below
+/// for interpenetrating ones.
+fn closest_yarns(p: &yarnhom_artifacts::Pattern) -> String {
+    match yarnhom_pattern::min_inter_yarn_distance(p) {
+        Some(m) => format!(
+            "closest centrelines: {:.3} radii apart (yarn {} edge {}, yarn {} edge {} in tile {:?})",
+            m.distance_m / p.yarns[m.a.yarn].radius_m,
+            m.a.yarn,
+            m.a.index,
+            m.b.yarn,
+            m.b.index,
+            m.image
+        ),
+        None => "closest centrelines: no two yarn pieces to compare".into(),
+    }
 }
