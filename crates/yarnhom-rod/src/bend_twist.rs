@@ -57,7 +57,7 @@ pub fn curvature_and_twist<T: DualNum<Primitive = f64> + Copy>(
     q: &[T; 11],
 ) -> ([T; 2], T) {
     let x = |i: usize| V3([q[3 * i], q[3 * i + 1], q[3 * i + 2]]);
-    let (e0, e1) = (x(1).sub(x(0)), x(2).sub(x(1)));
+    let (e0, e1) = (x(1) - x(0), x(2) - x(1));
     let (t0, t1) = (e0.normalized(), e1.normalized());
     let d0 = reference.frames[0].director_at(t0);
     let d1 = reference.frames[1].director_at(t1);
@@ -65,7 +65,7 @@ pub fn curvature_and_twist<T: DualNum<Primitive = f64> + Copy>(
     let (m1_1, m2_1) = material_frame(t1, d1, q[10]);
     let kb = t0.cross(t1).scale((t0.dot(t1) + 1.0).recip() * 2.0);
     let half = T::from(0.5);
-    let kappa = [m2_0.add(m2_1).dot(kb) * half, -(m1_0.add(m1_1).dot(kb) * half)];
+    let kappa = [(m2_0 + m2_1).dot(kb) * half, -((m1_0 + m1_1).dot(kb) * half)];
     let raw = signed_angle(parallel_transport(t0, t1, d0), d1, t1);
     let turns = ((reference.reference_twist_rad - raw.re()) / std::f64::consts::TAU).round();
     let reference_twist = raw + turns * std::f64::consts::TAU;
@@ -77,7 +77,7 @@ pub fn curvature_and_twist<T: DualNum<Primitive = f64> + Copy>(
 fn material_frame<T: DualNum<Primitive = f64> + Copy>(t: V3<T>, d: V3<T>, theta: T) -> (V3<T>, V3<T>) {
     let d2 = t.cross(d);
     let (s, c) = theta.sin_cos();
-    (d.scale(c).add(d2.scale(s)), d2.scale(c).sub(d.scale(s)))
+    (d.scale(c) + d2.scale(s), d2.scale(c) - d.scale(s))
 }
 
 impl BendTwist {

@@ -12,7 +12,7 @@ pub fn parallel_transport<T: DualNum<Primitive = f64> + Copy>(a: V3<T>, b: V3<T>
     let w = a.cross(b);
     let c = a.dot(b);
     let wv = w.cross(v);
-    v.add(wv).add(w.cross(wv).scale((c + 1.0).recip()))
+    v + wv + w.cross(wv).scale((c + 1.0).recip())
 }
 
 /// Signed angle from `u` to `v` about the unit `axis` (both orthogonal to it), in `(-pi, pi]`.
@@ -36,7 +36,7 @@ impl EdgeFrame {
     /// `hint` (projected onto the normal plane; any normal if `hint` is parallel to the edge).
     pub fn new(edge: [f64; 3], hint: [f64; 3]) -> Self {
         let t = V3::<f64>(edge).normalized();
-        let project = |h: V3<f64>| h.sub(t.scale(t.dot(h)));
+        let project = |h: V3<f64>| h - t.scale(t.dot(h));
         let mut d = project(V3(hint));
         if d.norm() < 1e-8 {
             let axis = if t.0[0].abs() < 0.9 { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
@@ -55,7 +55,7 @@ impl EdgeFrame {
         let t = V3::<f64>(edge).normalized();
         let d = self.director_at(t);
         // Re-orthonormalize against round-off drift.
-        let d = d.sub(t.scale(t.dot(d))).normalized();
+        let d = (d - t.scale(t.dot(d))).normalized();
         EdgeFrame { tangent: t.re(), director: d.re() }
     }
 }
@@ -69,9 +69,9 @@ mod tests {
         let a = V3::<f64>([1.0, 0.0, 0.0]);
         let b = V3::<f64>([0.6, 0.8, 0.0]);
         let moved = parallel_transport(a, b, a);
-        assert!(moved.sub(b).norm() < 1e-15);
+        assert!((moved - b).norm() < 1e-15);
         let v = V3([0.0, 0.0, 1.0]);
-        assert!(parallel_transport(a, b, v).sub(v).norm() < 1e-15, "the rotation axis is fixed");
+        assert!((parallel_transport(a, b, v) - v).norm() < 1e-15, "the rotation axis is fixed");
         let u = V3([0.0, 1.0, 0.0]);
         let pu = parallel_transport(a, b, u);
         assert!((pu.dot(b)).abs() < 1e-15 && (pu.norm() - 1.0).abs() < 1e-15);

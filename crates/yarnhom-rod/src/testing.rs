@@ -12,12 +12,13 @@ pub fn random_vector<const N: usize>(state: &mut u64, scale: f64) -> SVector<f64
     })
 }
 
+/// An element's energy, gradient and Hessian as a function of its DOFs.
+pub type ElementFn<'a, const N: usize> =
+    dyn Fn(&SVector<f64, N>) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>) + 'a;
+
 /// Central differences of energy and gradient against the analytic gradient (relative error
 /// below 1e-5) and Hessian (below 1e-4), with a step of 1e-6 of the DOF scale.
-pub fn check_derivatives<const N: usize>(
-    f: &dyn Fn(&SVector<f64, N>) -> (f64, SVector<f64, N>, SMatrix<f64, N, N>),
-    q: &SVector<f64, N>,
-) {
+pub fn check_derivatives<const N: usize>(f: &ElementFn<'_, N>, q: &SVector<f64, N>) {
     let (_, g, h) = f(q);
     let h_step = 1e-6 * q.amax().max(1e-3);
     let mut g_fd = SVector::<f64, N>::zeros();

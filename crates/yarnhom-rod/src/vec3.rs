@@ -1,6 +1,8 @@
 //! 3-vectors over any dual number (or plain `f64`), so that one energy function serves for the
 //! value and, evaluated on hyper-dual numbers, for exact gradients and Hessians.
 
+use std::ops::{Add, Sub};
+
 use num_dual::DualNum;
 
 /// A 3-vector of dual numbers.
@@ -11,16 +13,6 @@ impl<T: DualNum<Primitive = f64> + Copy> V3<T> {
     /// Lift a plain vector (constant: zero derivatives).
     pub fn constant(v: [f64; 3]) -> Self {
         V3(v.map(T::from))
-    }
-
-    /// `self + o`.
-    pub fn add(self, o: Self) -> Self {
-        V3([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
-    }
-
-    /// `self - o`.
-    pub fn sub(self, o: Self) -> Self {
-        V3([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
     }
 
     /// `s * self`.
@@ -52,5 +44,19 @@ impl<T: DualNum<Primitive = f64> + Copy> V3<T> {
     /// The real part.
     pub fn re(self) -> [f64; 3] {
         self.0.map(|c| c.re())
+    }
+}
+
+impl<T: DualNum<Primitive = f64> + Copy> Add for V3<T> {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        V3([self.0[0] + o.0[0], self.0[1] + o.0[1], self.0[2] + o.0[2]])
+    }
+}
+
+impl<T: DualNum<Primitive = f64> + Copy> Sub for V3<T> {
+    type Output = Self;
+    fn sub(self, o: Self) -> Self {
+        V3([self.0[0] - o.0[0], self.0[1] - o.0[1], self.0[2] - o.0[2]])
     }
 }
