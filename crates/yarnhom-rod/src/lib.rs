@@ -3,12 +3,14 @@
 //! - [`stretch`]: edge stretching, linear (discrete elastic rods) and biphasic (6.5);
 //! - [`bend_twist`]: bending and twisting of discrete elastic rods (Bergou et al. 2008, 2010)
 //!   with rest curvature and twist, `γ`-scaled stiffness (3.25) or isotropic `k_b` (6.6);
-//! - [`frames`]: parallel transport and time-parallel reference frames.
+//! - [`frames`]: parallel transport and time-parallel reference frames;
+//! - [`rod`]: one open or closed rod assembled from those elements.
 //!
 //! Contact energies (Kaldor et al. 2008 and the two-phase barrier (6.7)) come next.
 
 pub mod bend_twist;
 pub mod frames;
+pub mod rod;
 pub mod stretch;
 #[cfg(test)]
 mod testing;
@@ -16,4 +18,5 @@ pub mod vec3;
 
 pub use bend_twist::{BendTwist, BendTwistDofs, BendTwistReference, curvature_and_twist};
 pub use frames::EdgeFrame;
+pub use rod::{Rod, RodMaterial};
 pub use stretch::{StretchLaw, stretch_energy};
