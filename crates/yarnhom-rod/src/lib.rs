@@ -4,11 +4,13 @@
 //! - [`bend_twist`]: bending and twisting of discrete elastic rods (Bergou et al. 2008, 2010)
 //!   with rest curvature and twist, `γ`-scaled stiffness (3.25) or isotropic `k_b` (6.6);
 //! - [`frames`]: parallel transport and time-parallel reference frames;
-//! - [`rod`]: one open or closed rod assembled from those elements.
+//! - [`rod`]: one open or closed rod assembled from those elements;
 //!
-//! Contact energies (Kaldor et al. 2008 and the two-phase barrier (6.7)) come next.
+//! - [`contact`]: yarn-yarn contact between edges, Kaldor et al. (2008) and the two-phase
+//!   barrier (6.7).
 
 pub mod bend_twist;
+pub mod contact;
 pub mod frames;
 pub mod rod;
 pub mod stretch;
@@ -17,6 +19,7 @@ mod testing;
 pub mod vec3;
 
 pub use bend_twist::{BendTwist, BendTwistDofs, BendTwistReference, curvature_and_twist};
+pub use contact::{ContactLaw, contact_energy};
 pub use frames::EdgeFrame;
 pub use rod::{Rod, RodMaterial};
 pub use stretch::{StretchLaw, stretch_energy};

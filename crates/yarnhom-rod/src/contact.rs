@@ -1,0 +1,205 @@
+//! Yarn-yarn contact between two edges: a repulsion density integrated over both segments,
+//! `W = k L̄a L̄b ∫₀¹∫₀¹ φ(|xa(a) - xb(b)|) da db`, evaluated with Simpson's rule (3 x 3 points),
+//! as (6.7) prescribes. Two laws:
+//!
+//! - [`ContactLaw::Kaldor`]: Kaldor et al. (2008), the contact of Ch. 3-5 whose stiffness is the
+//!   `k_contact` of Table 4.1: `φ = f(D / 2r)` with `f(d) = 1/d² + d² - 2` for `d < 1`, else 0;
+//! - [`ContactLaw::TwoPhase`]: (6.7), a soft outer and a stiff inner barrier,
+//!   `φ = Σ_i k_ci g(min(D / 2R_i, 1))²` with the IPC barrier `g(x) = -(x - 1)² ln x`
+//!   (Li et al. 2020). The square is as printed in (6.7).
+//!
+//! With rest lengths in the factor, `k` is an energy per unit length squared (N/m). Gradient and
+//! Hessian are closed form: every quadrature point is a linear map of the 12 DOFs
+//! `(xa0, xa1, xb0, xb1)`.
+
+use nalgebra::{Matrix3, SMatrix, SVector, Vector3};
+
+/// A repulsion law between yarn centrelines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ContactLaw {
+    /// Kaldor et al. (2008) with contact stiffness `k_contact` (Table 4.1) and yarn radius `r`.
+    Kaldor {
+        /// Stiffness (kg/s², i.e. N/m).
+        stiffness: f64,
+        /// Yarn radius (m): the repulsion acts below a centreline distance of `2 r`.
+        radius_m: f64,
+    },
+    /// (6.7): outer (soft) and inner (stiff) barriers `(R_i, k_ci)`.
+    TwoPhase {
+        /// `(R_1, k_c1)`: outer radius (m) and stiffness (N/m).
+        outer: (f64, f64),
+        /// `(R_2, k_c2)`: inner radius (m) and stiffness (N/m).
+        inner: (f64, f64),
+    },
+}
+
+/// `(φ, φ', φ'')` of `f(D / 2r)` with its stiffness, for the distance `D`.
+fn kaldor(distance: f64, stiffness: f64, radius: f64) -> (f64, f64, f64) {
+    let s = 1.0 / (2.0 * radius);
+    let d = distance * s;
+    if d >= 1.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let (d2, d3, d4) = (d * d, d * d * d, d * d * d * d);
+    let f = 1.0 / d2 + d2 - 2.0;
+    let df = -2.0 / d3 + 2.0 * d;
+    let ddf = 6.0 / d4 + 2.0;
+    (stiffness * f, stiffness * df * s, stiffness * ddf * s * s)
+}
+
+/// `(φ, φ', φ'')` of `k g(min(D / 2R, 1))²` with the IPC barrier `g(x) = -(x - 1)² ln x`.
+fn squared_ipc(distance: f64, stiffness: f64, radius: f64) -> (f64, f64, f64) {
+    let s = 1.0 / (2.0 * radius);
+    let x = distance * s;
+    if x >= 1.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let ln = x.ln();
+    let g = -(x - 1.0).powi(2) * ln;
+    let dg = -2.0 * (x - 1.0) * ln - (x - 1.0).powi(2) / x;
+    let ddg = -2.0 * ln - 4.0 * (x - 1.0) / x + (x - 1.0).powi(2) / (x * x);
+    // (g²)' = 2 g g', (g²)'' = 2 (g'² + g g'').
+    (stiffness * g * g, stiffness * 2.0 * g * dg * s, stiffness * 2.0 * (dg * dg + g * ddg) * s * s)
+}
+
+impl ContactLaw {
+    /// `(φ, dφ/dD, d²φ/dD²)` at centreline distance `D`.
+    pub fn density(&self, distance: f64) -> (f64, f64, f64) {
+        match *self {
+            ContactLaw::Kaldor { stiffness, radius_m } => kaldor(distance, stiffness, radius_m),
+            ContactLaw::TwoPhase { outer, inner } => {
+                let (a, b) =
+                    (squared_ipc(distance, outer.1, outer.0), squared_ipc(distance, inner.1, inner.0));
+                (a.0 + b.0, a.1 + b.1, a.2 + b.2)
+            }
+        }
+    }
+
+    /// The distance beyond which there is no repulsion (m).
+    pub fn reach_m(&self) -> f64 {
+        match *self {
+            ContactLaw::Kaldor { radius_m, .. } => 2.0 * radius_m,
+            ContactLaw::TwoPhase { outer, inner } => 2.0 * outer.0.max(inner.0),
+        }
+    }
+}
+
+/// Simpson's rule on `[0, 1]`: nodes and weights.
+const SIMPSON: [(f64, f64); 3] = [(0.0, 1.0 / 6.0), (0.5, 4.0 / 6.0), (1.0, 1.0 / 6.0)];
+
+/// Energy, gradient and Hessian of the contact between edge `a` (`xa0 -> xa1`, rest length
+/// `rest_a`) and edge `b`; DOFs ordered `(xa0, xa1, xb0, xb1)`.
+pub fn contact_energy(
+    law: &ContactLaw,
+    [xa0, xa1, xb0, xb1]: [&Vector3<f64>; 4],
+    rest_a: f64,
+    rest_b: f64,
+) -> (f64, SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+    let scale = rest_a * rest_b;
+    let mut energy = 0.0;
+    let mut gradient = SVector::<f64, 12>::zeros();
+    let mut hessian = SMatrix::<f64, 12, 12>::zeros();
+    for &(sa, wa) in &SIMPSON {
+        for &(sb, wb) in &SIMPSON {
+            let v = xa0 * (1.0 - sa) + xa1 * sa - xb0 * (1.0 - sb) - xb1 * sb;
+            let distance = v.norm();
+            let (phi, dphi, ddphi) = law.density(distance);
+            if phi == 0.0 && dphi == 0.0 {
+                continue;
+            }
+            let w = scale * wa * wb;
+            let n = v / distance;
+            let g_v = n * (w * dphi);
+            let nn = n * n.transpose();
+            let h_v = nn * (w * ddphi) + (Matrix3::identity() - nn) * (w * dphi / distance);
+            // v = Σ c_k x_k with c = (1 - sa, sa, -(1 - sb), -sb).
+            let c = [1.0 - sa, sa, -(1.0 - sb), -sb];
+            energy += w * phi;
+            for (k, &ck) in c.iter().enumerate() {
+                let mut rows = gradient.fixed_rows_mut::<3>(3 * k);
+                rows += g_v * ck;
+                for (l, &cl) in c.iter().enumerate() {
+                    let mut block = hessian.fixed_view_mut::<3, 3>(3 * k, 3 * l);
+                    block += h_v * (ck * cl);
+                }
+            }
+        }
+    }
+    (energy, gradient, hessian)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testing::{check_derivatives, random_vector};
+
+    const LAWS: [ContactLaw; 2] = [
+        ContactLaw::Kaldor { stiffness: 60.0, radius_m: 0.5 },
+        ContactLaw::TwoPhase { outer: (0.5, 1.0), inner: (0.125, 1e3) },
+    ];
+
+    fn energy_of(law: &ContactLaw, q: &SVector<f64, 12>) -> (f64, SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+        let x = |k: usize| Vector3::new(q[3 * k], q[3 * k + 1], q[3 * k + 2]);
+        let (a0, a1, b0, b1) = (x(0), x(1), x(2), x(3));
+        contact_energy(law, [&a0, &a1, &b0, &b1], 1.1, 0.9)
+    }
+
+    /// Two crossing edges of length ~1 whose centrelines come within about `gap` of each other.
+    fn crossing(gap: f64) -> SVector<f64, 12> {
+        SVector::from_column_slice(&[-0.5, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, -0.5, gap, 0.0, 0.5, gap])
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        let mut rng = 3u64;
+        for law in LAWS {
+            for _ in 0..60 {
+                let q = crossing(0.45) + random_vector::<12>(&mut rng, 0.15);
+                check_derivatives(&|q: &SVector<f64, 12>| energy_of(&law, q), &q);
+            }
+        }
+    }
+
+    #[test]
+    fn no_repulsion_beyond_reach_and_growing_repulsion_when_closer() {
+        for law in LAWS {
+            assert_eq!(energy_of(&law, &crossing(1.01 * law.reach_m())).0, 0.0);
+            let energies: Vec<f64> =
+                [0.9, 0.7, 0.5, 0.3, 0.1].iter().map(|g| energy_of(&law, &crossing(*g)).0).collect();
+            assert!(energies.windows(2).all(|w| w[1] > w[0]), "{law:?}: {energies:?}");
+            // The force pushes the upper edge up (negative gradient in +z on edge b).
+            let (_, g, _) = energy_of(&law, &crossing(0.4));
+            assert!(g[8] < 0.0 && g[11] < 0.0 && g[2] > 0.0 && g[5] > 0.0);
+        }
+    }
+
+    #[test]
+    fn contact_is_symmetric_and_invariant_under_rigid_motions() {
+        let mut rng = 9u64;
+        let q = crossing(0.4) + random_vector::<12>(&mut rng, 0.1);
+        let r = nalgebra::Rotation3::new(Vector3::new(0.4, 1.2, -0.3));
+        for law in LAWS {
+            let e = energy_of(&law, &q).0;
+            let mut moved = q;
+            for k in 0..4 {
+                let p = r * Vector3::new(q[3 * k], q[3 * k + 1], q[3 * k + 2]) + Vector3::new(3.0, -1.0, 2.0);
+                moved.fixed_rows_mut::<3>(3 * k).copy_from(&p);
+            }
+            assert!((energy_of(&law, &moved).0 - e).abs() < 1e-12 * e);
+            let x = |k: usize| Vector3::new(q[3 * k], q[3 * k + 1], q[3 * k + 2]);
+            let swapped = contact_energy(&law, [&x(2), &x(3), &x(0), &x(1)], 0.9, 1.1).0;
+            assert!((swapped - e).abs() < 1e-12 * e);
+        }
+    }
+
+    #[test]
+    fn the_barriers_have_their_published_shapes() {
+        // Kaldor: f(d) = 1/d² + d² - 2: f(1/2) = 4 + 1/4 - 2 = 2.25 (times k).
+        let (phi, _, _) = ContactLaw::Kaldor { stiffness: 2.0, radius_m: 1.0 }.density(1.0);
+        assert!((phi - 4.5).abs() < 1e-12);
+        // IPC: g(1/2) = -(1/4) ln(1/2); (6.7) squares it.
+        let (phi, _, _) = ContactLaw::TwoPhase { outer: (1.0, 3.0), inner: (0.1, 0.0) }.density(1.0);
+        let g = -0.25 * 0.5f64.ln();
+        assert!((phi - 3.0 * g * g).abs() < 1e-12);
+    }
+}
