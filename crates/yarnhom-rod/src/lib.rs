@@ -4,10 +4,9 @@
 //! - [`bend_twist`]: bending and twisting of discrete elastic rods (Bergou et al. 2008, 2010)
 //!   with rest curvature and twist, `γ`-scaled stiffness (3.25) or isotropic `k_b` (6.6);
 //! - [`frames`]: parallel transport and time-parallel reference frames;
-//! - [`rod`]: one open or closed rod assembled from those elements;
-//!
 //! - [`contact`]: yarn-yarn contact between edges, Kaldor et al. (2008) and the two-phase
-//!   barrier (6.7).
+//!   barrier (6.7);
+//! - [`rod`]: one open or closed rod assembled from the stretch and bend-twist elements.
 
 pub mod bend_twist;
 pub mod contact;
