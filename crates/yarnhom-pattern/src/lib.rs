@@ -14,7 +14,7 @@ pub mod weave;
 use yarnhom_artifacts::{Fabric, Pattern, Yarn};
 
 use knit::Stitch::{Knit as K, Purl as P};
-pub use min_distance::{EdgeRef, MinDistance, min_inter_yarn_distance};
+pub use min_distance::{EdgeRef, MinDistance, YarnNeighbours, min_inter_yarn_distance};
 
 /// A generator's size and resolution parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
