@@ -147,6 +147,74 @@ impl Pattern {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), y| (lo.min(y.radius_m), hi.max(y.radius_m)))
     }
 
+    /// The `nx x ny` tiling of this pattern as one larger tile: vertices copied per tile
+    /// (copy `(i, j)` holds vertices `(j nx + i) n ..`), yarns re-traced through the copies, rest
+    /// state copied. Homogenized quantities of the tiling equal those of the tile.
+    pub fn tiled(&self, nx: u32, ny: u32) -> Pattern {
+        let (nx, ny) = (nx.max(1) as i32, ny.max(1) as i32);
+        let n = self.vertex_count();
+        let copy_index = |c: [i32; 2]| (c[1] * nx + c[0]) as usize;
+        let mut positions = Vec::with_capacity(n * (nx * ny) as usize);
+        for j in 0..ny {
+            for i in 0..nx {
+                positions.extend(self.positions_m.iter().map(|p| {
+                    [p[0] + f64::from(i) * self.period_m[0], p[1] + f64::from(j) * self.period_m[1], p[2]]
+                }));
+            }
+        }
+        let mut next = vec![(0u32, [0i32; 2], 0usize); n];
+        for e in self.edges() {
+            next[e.from as usize] = (e.to, e.offset, e.yarn);
+        }
+        let mut seen = vec![false; positions.len()];
+        let mut yarns = Vec::new();
+        for start in 0..positions.len() {
+            if seen[start] {
+                continue;
+            }
+            let mut yarn = Yarn { radius_m: 0.0, vertices: vec![], edge_offsets: vec![] };
+            let mut at = start;
+            while !seen[at] {
+                seen[at] = true;
+                let (v, c) = (at % n, at / n);
+                let copy = [(c as i32) % nx, (c as i32) / nx];
+                let (to, offset, y) = next[v];
+                let target = [copy[0] + offset[0], copy[1] + offset[1]];
+                let wrapped = [target[0].rem_euclid(nx), target[1].rem_euclid(ny)];
+                yarn.radius_m = self.yarns[y].radius_m;
+                yarn.vertices.push(at as u32);
+                yarn.edge_offsets.push([target[0].div_euclid(nx), target[1].div_euclid(ny)]);
+                at = copy_index(wrapped) * n + to as usize;
+            }
+            yarns.push(yarn);
+        }
+        let copies = (nx * ny) as usize;
+        let repeat = |v: &Vec<f64>| v.iter().copied().cycle().take(n * copies).collect::<Vec<f64>>();
+        let rest = self.rest.as_ref().map(|r| RestState {
+            edge_length_m: repeat(&r.edge_length_m),
+            vertex_curvature: r.vertex_curvature.iter().copied().cycle().take(n * copies).collect(),
+            vertex_twist_rad: repeat(&r.vertex_twist_rad),
+            edge_reference_director: r
+                .edge_reference_director
+                .iter()
+                .copied()
+                .cycle()
+                .take(n * copies)
+                .collect(),
+            vertex_reference_twist_rad: repeat(&r.vertex_reference_twist_rad),
+        });
+        Pattern {
+            name: format!("{}-{nx}x{ny}", self.name),
+            fabric: self.fabric,
+            period_m: [self.period_m[0] * f64::from(nx), self.period_m[1] * f64::from(ny)],
+            edge_twist_rad: repeat(&self.edge_twist_rad),
+            positions_m: positions,
+            yarns,
+            rest,
+            origin: format!("{nx}x{ny} tiling of {}", self.origin),
+        }
+    }
+
     /// Check every invariant of a pattern; the error names the offending field.
     pub fn validate(&self) -> Result<(), ValidationError> {
         check::positive("period_m[0]", self.period_m[0])?;

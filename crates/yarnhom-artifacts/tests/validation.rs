@@ -155,3 +155,32 @@ fn malformed_pyp_is_reported_with_its_line() {
     // Geometry that parses but breaks an invariant is a validation error naming the field.
     assert!(pyp_error(&with_line(1, "1 1 -0.01 4")).contains("radius_m"));
 }
+
+#[test]
+fn a_tiling_is_a_valid_pattern_with_the_same_geometry_per_tile() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/data/hylc-patterns/stock.pyp"
+    ))
+    .expect("published stock");
+    let p = parse_pyp(&text, "stock", None).expect("imports");
+    for (nx, ny) in [(2, 1), (1, 2), (3, 2)] {
+        let t = p.tiled(nx, ny);
+        t.validate().unwrap_or_else(|e| panic!("{nx}x{ny}: {e}"));
+        let copies = (nx * ny) as usize;
+        assert_eq!(t.vertex_count(), copies * p.vertex_count());
+        assert_eq!(t.period_m, [p.period_m[0] * f64::from(nx), p.period_m[1] * f64::from(ny)]);
+        // Same multiset of edge vectors, each repeated once per copy.
+        let vectors = |q: &Pattern| {
+            let mut v: Vec<[i64; 3]> =
+                q.edges().map(|e| q.edge_vector(&e).map(|c| (c * 1e9).round() as i64)).collect();
+            v.sort();
+            v
+        };
+        let mut expected: Vec<[i64; 3]> =
+            vectors(&p).into_iter().flat_map(|v| std::iter::repeat_n(v, copies)).collect();
+        expected.sort();
+        assert_eq!(vectors(&t), expected, "{nx}x{ny}");
+        assert_eq!(t.rest.as_ref().expect("rest").edge_length_m.len(), t.vertex_count());
+    }
+}

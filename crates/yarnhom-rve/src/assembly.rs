@@ -1,0 +1,312 @@
+//! Energy, gradient and Hessian of the tile over its DOFs `g` (positions then twists).
+//!
+//! Every element is evaluated on world positions of vertex instances; derivatives are pulled
+//! back to the tile DOFs through `x = ... + R(X) g`: `∇_g = Rᵀ ∇_x`, `H_gg' = Rᵀ H_xx' R'`.
+
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use yarnhom_pattern::min_distance::lower_bound;
+use yarnhom_rod::{
+    BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
+};
+
+use crate::model::{BendElement, RveModel};
+use crate::placement::{Instance, Placement};
+
+/// Energy (J), gradient and Hessian triplets `(row, column, value)` (duplicates summed).
+#[derive(Debug, Clone)]
+pub struct Assembled {
+    /// Total energy of the tile (J).
+    pub energy_j: f64,
+    /// Gradient over the DOFs.
+    pub gradient: DVector<f64>,
+    /// Hessian triplets; empty when only the energy was asked for.
+    pub hessian: Vec<(usize, usize, f64)>,
+}
+
+/// What to assemble.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Want {
+    /// Energy only (line searches).
+    Energy,
+    /// Energy, gradient and Hessian.
+    Derivatives,
+}
+
+/// The iterate of a tile solve: DOFs and the reference frames they are measured against.
+#[derive(Debug, Clone)]
+pub struct RveState {
+    /// DOFs: unrotated fluctuations `g = Rᵀũ` (3 per vertex), then edge twists.
+    pub g: DVector<f64>,
+    /// Frame of each edge (by source vertex) at its tile instance, in world coordinates.
+    pub frames: Vec<EdgeFrame>,
+    /// Reference twist of each bend element at the last frame update (rad).
+    pub reference_twists: Vec<f64>,
+}
+
+impl RveState {
+    /// The affine start (A.2.3, "initial guess"): zero fluctuation, so the tile is deformed
+    /// rigidly by the macro strain; edge twists as in the pattern; reference frames co-rotated
+    /// (3.26) and parallel transported onto the deformed edges.
+    pub fn affine(model: &RveModel, placement: &Placement) -> Self {
+        let mut g = DVector::zeros(model.dof_count());
+        for (v, &theta) in model.material_twists.iter().enumerate() {
+            g[model.twist_dof(v as u32)] = theta;
+        }
+        let frames = model
+            .stretch
+            .iter()
+            .map(|s| {
+                let v = s.from.vertex as usize;
+                let material_edge = model.material[s.to.vertex as usize]
+                    + Vector3::new(
+                        f64::from(s.to.image[0]) * model.period_m[0],
+                        f64::from(s.to.image[1]) * model.period_m[1],
+                        0.0,
+                    )
+                    - model.material[v];
+                let r = placement.rotation(s.from);
+                let flat = EdgeFrame::new(material_edge.into(), model.material_directors[v]);
+                let rotate = |a: [f64; 3]| (r * Vector3::from(a)).into();
+                let corotated = EdgeFrame { tangent: rotate(flat.tangent), director: rotate(flat.director) };
+                corotated.updated(world_edge(model, placement, &g, s.from, s.to).into())
+            })
+            .collect();
+        let mut state = RveState { g, frames, reference_twists: model.material_reference_twists.clone() };
+        state.reference_twists = reference_twists(model, placement, &state);
+        state
+    }
+
+    /// Move the reference frames onto the current configuration (time-parallel transport) and
+    /// record the reference twists there; call after every accepted step.
+    pub fn update_frames(&mut self, model: &RveModel, placement: &Placement) {
+        self.frames = model
+            .stretch
+            .iter()
+            .zip(&self.frames)
+            .map(|(s, f)| f.updated(world_edge(model, placement, &self.g, s.from, s.to).into()))
+            .collect();
+        self.reference_twists = reference_twists(model, placement, self);
+    }
+}
+
+fn position_of(model: &RveModel, placement: &Placement, g: &DVector<f64>, i: Instance) -> Vector3<f64> {
+    let k = model.position_dof(i.vertex);
+    placement.position(i, &Vector3::new(g[k], g[k + 1], g[k + 2]))
+}
+
+fn world_edge(
+    model: &RveModel,
+    placement: &Placement,
+    g: &DVector<f64>,
+    a: Instance,
+    b: Instance,
+) -> Vector3<f64> {
+    position_of(model, placement, g, b) - position_of(model, placement, g, a)
+}
+
+/// The frame of the edge leaving `source` in tile image `image`: the stored frame co-rotated
+/// by `R(image) R(tile)ᵀ`, with `R` taken at the edge's first vertex (A.21).
+fn frame_in_image(placement: &Placement, state: &RveState, source: u32, image: [i32; 2]) -> EdgeFrame {
+    let f = state.frames[source as usize];
+    if image == [0, 0] {
+        return f;
+    }
+    let q: Matrix3<f64> = placement.rotation(Instance { vertex: source, image })
+        * placement.rotation(Instance { vertex: source, image: [0, 0] }).transpose();
+    let rotate = |a: [f64; 3]| (q * Vector3::from(a)).into();
+    EdgeFrame { tangent: rotate(f.tangent), director: rotate(f.director) }
+}
+
+fn bend_reference(
+    placement: &Placement,
+    state: &RveState,
+    b: &BendElement,
+    index: usize,
+) -> BendTwistReference {
+    BendTwistReference {
+        frames: [
+            frame_in_image(placement, state, b.prev.vertex, b.prev.image),
+            state.frames[b.vertex.vertex as usize],
+        ],
+        reference_twist_rad: state.reference_twists[index],
+    }
+}
+
+fn bend_dofs(model: &RveModel, placement: &Placement, g: &DVector<f64>, b: &BendElement) -> BendTwistDofs {
+    let [p, v, n] = [b.prev, b.vertex, b.next].map(|i| position_of(model, placement, g, i));
+    let (t_in, t_out) = (g[model.twist_dof(b.prev.vertex)], g[model.twist_dof(b.vertex.vertex)]);
+    BendTwistDofs::from_column_slice(&[p.x, p.y, p.z, v.x, v.y, v.z, n.x, n.y, n.z, t_in, t_out])
+}
+
+fn reference_twists(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<f64> {
+    model
+        .bends
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let reference = bend_reference(placement, state, b, k);
+            let q = bend_dofs(model, placement, &state.g, b);
+            let (_, twist) = curvature_and_twist(&reference, &std::array::from_fn(|i| q[i]));
+            twist - (q[10] - q[9])
+        })
+        .collect()
+}
+
+/// Pull an element's derivatives back to the tile DOFs and add them in.
+struct Scatter<'a> {
+    model: &'a RveModel,
+    placement: &'a Placement,
+    out: &'a mut Assembled,
+}
+
+impl Scatter<'_> {
+    /// `instances`: the element's vertices (3 local DOFs each, first); `twists`: the source
+    /// vertices of its twisted edges (1 local DOF each, after the positions).
+    fn add(&mut self, instances: &[Instance], twists: &[u32], g: &[f64], h: Option<&DMatrix<f64>>) {
+        let k = 3 * instances.len() + twists.len();
+        let mut t = DMatrix::<f64>::identity(k, k);
+        let mut index = Vec::with_capacity(k);
+        for (i, inst) in instances.iter().enumerate() {
+            t.fixed_view_mut::<3, 3>(3 * i, 3 * i).copy_from(&self.placement.rotation(*inst));
+            let base = self.model.position_dof(inst.vertex);
+            index.extend([base, base + 1, base + 2]);
+        }
+        index.extend(twists.iter().map(|&e| self.model.twist_dof(e)));
+        let gl = t.transpose() * DVector::from_column_slice(g);
+        for (a, &i) in index.iter().enumerate() {
+            self.out.gradient[i] += gl[a];
+        }
+        if let Some(h) = h {
+            let hl = t.transpose() * h * &t;
+            for (a, &i) in index.iter().enumerate() {
+                for (b, &j) in index.iter().enumerate() {
+                    self.out.hessian.push((i, j, hl[(a, b)]));
+                }
+            }
+        }
+    }
+}
+
+/// Assemble the tile's energy (and derivatives) at DOFs `g`, measured against `state`'s frames.
+pub fn assemble(
+    model: &RveModel,
+    placement: &Placement,
+    state: &RveState,
+    g: &DVector<f64>,
+    want: Want,
+) -> Assembled {
+    let mut out =
+        Assembled { energy_j: 0.0, gradient: DVector::zeros(model.dof_count()), hessian: Vec::new() };
+    let derivatives = want == Want::Derivatives;
+    let position = |i: Instance| position_of(model, placement, g, i);
+    for s in &model.stretch {
+        let (e, grad, hess) =
+            stretch_energy(&model.material_law.stretch, s.rest_length_m, &position(s.from), &position(s.to));
+        out.energy_j += e;
+        let h = derivatives.then(|| DMatrix::from_column_slice(6, 6, hess.as_slice()));
+        Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h.as_ref());
+    }
+    for (k, b) in model.bends.iter().enumerate() {
+        let reference = bend_reference(placement, state, b, k);
+        let q = bend_dofs(model, placement, g, b);
+        let twists = [b.prev.vertex, b.vertex.vertex];
+        if derivatives {
+            let (e, grad, hess) = b.element.energy_gradient_hessian(&reference, &q);
+            out.energy_j += e;
+            let h = DMatrix::from_column_slice(11, 11, hess.as_slice());
+            Scatter { model, placement, out: &mut out }.add(
+                &[b.prev, b.vertex, b.next],
+                &twists,
+                grad.as_slice(),
+                Some(&h),
+            );
+        } else {
+            out.energy_j += b.element.energy(&reference, &q);
+        }
+    }
+    add_contacts(model, placement, g, derivatives, &mut out);
+    out
+}
+
+/// Contact between every edge of the tile and every edge of the tile images within reach
+/// ([`RveModel::images`]), each physical pair once, neighbours along a yarn excluded.
+fn add_contacts(
+    model: &RveModel,
+    placement: &Placement,
+    g: &DVector<f64>,
+    derivatives: bool,
+    out: &mut Assembled,
+) {
+    let reach = model.contact.reach_m();
+    let shifted = |i: Instance, o: [i32; 2]| Instance {
+        vertex: i.vertex,
+        image: [i.image[0] + o[0], i.image[1] + o[1]],
+    };
+    // Endpoints of every edge in every image.
+    let ends: Vec<Vec<(Vector3<f64>, Vector3<f64>)>> = model
+        .images
+        .iter()
+        .map(|&o| {
+            model
+                .stretch
+                .iter()
+                .map(|s| {
+                    (
+                        position_of(model, placement, g, shifted(s.from, o)),
+                        position_of(model, placement, g, shifted(s.to, o)),
+                    )
+                })
+                .collect()
+        })
+        .collect();
+    let tile_index = model.images.iter().position(|&o| o == [0, 0]).expect("the tile itself is an image");
+    let tile = &ends[tile_index];
+    for (a, sa) in model.stretch.iter().enumerate() {
+        for (image_index, &o) in model.images.iter().enumerate() {
+            for (b, sb) in model.stretch.iter().enumerate() {
+                // Each physical pair once: (a, b, o) and (b, a, -o) are the same pair.
+                if !(a < b || (a == b && o > [0, 0])) {
+                    continue;
+                }
+                let (a0, a1) = tile[a];
+                let (b0, b1) = ends[image_index][b];
+                if lower_bound(&a0, &a1, &b0, &b1) >= reach
+                    || model.neighbours.are_neighbours(sa.from.vertex, sb.from.vertex, o)
+                {
+                    continue;
+                }
+                let (e, grad, hess) = contact_energy(
+                    &model.contact,
+                    [&a0, &a1, &b0, &b1],
+                    model.rest_length_m[a],
+                    model.rest_length_m[b],
+                );
+                if e == 0.0 && grad.amax() == 0.0 {
+                    continue;
+                }
+                out.energy_j += e;
+                let h = derivatives.then(|| DMatrix::from_column_slice(12, 12, hess.as_slice()));
+                let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
+                Scatter { model, placement, out: &mut *out }.add(
+                    &instances,
+                    &[],
+                    grad.as_slice(),
+                    h.as_ref(),
+                );
+            }
+        }
+    }
+}
+
+/// Energy of every bend-twist element (J), in vertex order: where a tile stores bending.
+pub fn bend_energies(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<f64> {
+    model
+        .bends
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            b.element
+                .energy(&bend_reference(placement, state, b, k), &bend_dofs(model, placement, &state.g, b))
+        })
+        .collect()
+}

@@ -1,0 +1,20 @@
+//! The periodic yarn tile of thesis Ch. 3.
+//!
+//! Implementation choice: the "alternative implementation" of Sec. 3.3.3. The unknowns are only
+//! the tile's own DOFs `g = (Rᵀũ, θ)`: the unrotated fluctuation of every vertex and the twist of
+//! every edge. Periodic images are copies placed by the co-rotated map
+//! `x = φ(X) + h n(X) + R(X) g` (3.13, 3.21), with `X` the vertex's material point in its tile
+//! image, so the periodicity constraints (3.21, 3.27) hold by construction and every element is
+//! counted exactly once (no ghost segments, no fractional counting).
+//!
+//! - [`model`]: the tile's elements and rest state, built from a pattern and a yarn model;
+//! - [`placement`]: where vertex instances go under a macro strain;
+//! - [`assembly`]: energy, gradient and Hessian over `g`.
+
+pub mod assembly;
+pub mod model;
+pub mod placement;
+
+pub use assembly::Assembled;
+pub use model::{RveError, RveModel};
+pub use placement::Placement;

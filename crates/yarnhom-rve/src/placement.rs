@@ -1,0 +1,51 @@
+//! The co-rotated placement of vertex instances: `x = φ(X) + h n(X) + R(X) g` (3.13) with
+//! `g = Rᵀũ` the tile DOF (periodic by construction, (3.21)).
+
+use nalgebra::{Matrix3, Vector2, Vector3};
+use yarnhom_geom::{MacroStrain, Midsurface};
+
+/// A vertex of the tile in one periodic image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Instance {
+    /// Vertex index in the tile.
+    pub vertex: u32,
+    /// Tile image offset.
+    pub image: [i32; 2],
+}
+
+/// Material points of the tile's vertices and the midsurface they are placed on.
+#[derive(Debug, Clone)]
+pub struct Placement {
+    /// Material coordinates `(X1, X2, h)` of each vertex in the tile (rest geometry, centred).
+    material: Vec<Vector3<f64>>,
+    period_m: [f64; 2],
+    midsurface: Midsurface,
+}
+
+impl Placement {
+    /// The placement of a tile with material points `material` (m) and periods `period_m`
+    /// under `strain`.
+    pub fn new(material: Vec<Vector3<f64>>, period_m: [f64; 2], strain: &MacroStrain) -> Self {
+        Placement { material, period_m, midsurface: Midsurface::new(strain) }
+    }
+
+    fn material_point(&self, i: Instance) -> (Vector2<f64>, f64) {
+        let m = self.material[i.vertex as usize];
+        let x = Vector2::new(
+            m.x + f64::from(i.image[0]) * self.period_m[0],
+            m.y + f64::from(i.image[1]) * self.period_m[1],
+        );
+        (x, m.z)
+    }
+
+    /// The rotation `R(X)` at an instance: maps its DOF `g` to the world fluctuation `ũ`.
+    pub fn rotation(&self, i: Instance) -> Matrix3<f64> {
+        self.midsurface.rotation(&self.material_point(i).0)
+    }
+
+    /// World position of an instance with tile DOF `g`.
+    pub fn position(&self, i: Instance, g: &Vector3<f64>) -> Vector3<f64> {
+        let (x, h) = self.material_point(i);
+        self.midsurface.position(&x) + self.midsurface.normal(&x) * h + self.midsurface.rotation(&x) * g
+    }
+}
