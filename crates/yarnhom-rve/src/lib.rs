@@ -9,12 +9,17 @@
 //!
 //! - [`model`]: the tile's elements and rest state, built from a pattern and a yarn model;
 //! - [`placement`]: where vertex instances go under a macro strain;
-//! - [`assembly`]: energy, gradient and Hessian over `g`.
+//! - [`assembly`]: energy, gradient and Hessian over `g`;
+//! - [`solve`]: the constrained Newton solve for the tile's equilibrium;
+//! - [`linear`]: sparse Cholesky with reused symbolic analysis.
 
 pub mod assembly;
+pub mod linear;
 pub mod model;
 pub mod placement;
+pub mod solve;
 
 pub use assembly::Assembled;
 pub use model::{RveError, RveModel};
 pub use placement::Placement;
+pub use solve::{SolveOptions, SolveReport, StopReason, solve};

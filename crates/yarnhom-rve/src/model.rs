@@ -54,6 +54,17 @@ pub struct BendElement {
     pub element: BendTwist,
 }
 
+/// One yarn of the tile, as the constraints see it.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct YarnInfo {
+    /// Its vertices.
+    pub vertices: Vec<u32>,
+    /// Tile offset after one pass along the yarn.
+    pub closure: [i32; 2],
+    /// A vertex whose outgoing edge crosses the tile boundary: held on the boundary (3.29).
+    pub boundary_vertex: u32,
+}
+
 /// The tile: topology, rest state and materials. Edges are indexed by their source vertex.
 #[derive(Debug, Clone)]
 pub struct RveModel {
@@ -84,6 +95,9 @@ pub struct RveModel {
     pub rest_length_m: Vec<f64>,
     /// Smallest yarn radius (m): the scale of step limits and tolerances.
     pub radius_m: f64,
+    /// The yarns: vertices, closure offset, and the vertex held on the tile boundary by the
+    /// sliding constraint (3.29).
+    pub yarns: Vec<YarnInfo>,
     /// Tile images whose edges can come within contact reach of the tile's own edges: yarns
     /// reach out of their tile (loops are wider than stitches), so this may go beyond the 8
     /// neighbours.
@@ -152,8 +166,21 @@ impl RveModel {
                 }
             })
             .collect();
+        let yarns = pattern
+            .yarns
+            .iter()
+            .map(|y| {
+                let crossing = y.edge_offsets.iter().position(|o| *o != [0, 0]).unwrap_or(0);
+                YarnInfo {
+                    vertices: y.vertices.clone(),
+                    closure: y.closure_offset(),
+                    boundary_vertex: y.vertices[crossing],
+                }
+            })
+            .collect();
         let images = contact_images(&material, pattern.period_m, contact.reach_m() * 1.5);
         Ok(RveModel {
+            yarns,
             images,
             vertices: n,
             period_m: pattern.period_m,

@@ -38,6 +38,17 @@ impl Placement {
         (x, m.z)
     }
 
+    /// The in-plane stretch `S̄` (3x2) of the macro strain (A.11).
+    pub fn in_plane_stretch(&self) -> nalgebra::Matrix3x2<f64> {
+        self.midsurface.stretch
+    }
+
+    /// The smallest eigenvalue of the first fundamental form (`λ_min` of the step limit, A.2.3).
+    pub fn smallest_stretch_eigenvalue(&self) -> f64 {
+        let s = self.midsurface.stretch;
+        (s.transpose() * s).symmetric_eigenvalues().min()
+    }
+
     /// The rotation `R(X)` at an instance: maps its DOF `g` to the world fluctuation `ũ`.
     pub fn rotation(&self, i: Instance) -> Matrix3<f64> {
         self.midsurface.rotation(&self.material_point(i).0)

@@ -1,0 +1,251 @@
+//! Elastostatic equilibrium of the tile (3.24): constrained Newton (3.32, A.2.3).
+//!
+//! - constraints `C g = d`, kept exactly from a feasible start: translation (3.19, the mean of
+//!   the unrotated fluctuations is fixed), zero mean twist per yarn (3.28, the sum of edge twists
+//!   is kept), and sliding (3.29: one boundary vertex per yarn keeps its fluctuation along the
+//!   deformed boundary normal `S̄ N`); periodicity (3.21, 3.26-3.27) holds by construction;
+//! - each step solves the scaled, regularized system (A.30) `(M H M + α I) w = -M ∇E` under the
+//!   constraints by the range-space method on one sparse Cholesky factorization, `δ = M w`, with
+//!   `M = 1` for positions and `10⁶ r` for twists, and `α = α̂ ‖M ∇E‖∞` decaying `α̂` from 5000 to 5
+//!   over 400 iterations; `α` grows tenfold whenever the factorization finds the matrix indefinite;
+//! - steps are limited so that no vertex moves more than `p r`, `p = 0.05 + 0.15 clamp(λ_min(I))`,
+//!   then shortened tenfold until the energy decreases (A.2.3);
+//! - convergence when the gradient projected on the constraints' tangent space falls below
+//!   `ε_z = 1e-5` of its value at the affine start (A.31-A.33; measured against the affine start
+//!   rather than the first iterate, so that a warm start is held to the same absolute accuracy).
+
+use nalgebra::{DMatrix, DVector, Vector2};
+
+use crate::assembly::{RveState, Want, assemble};
+use crate::linear::SpdSolver;
+use crate::model::RveModel;
+use crate::placement::Placement;
+
+/// Solver settings (defaults: App. A.2.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveOptions {
+    /// Iteration limit.
+    pub max_iterations: usize,
+    /// `ε_z` of (A.33).
+    pub tolerance: f64,
+    /// `α̂_0` and `α̂_N` of the regularization schedule (A.30).
+    pub regularization: (f64, f64),
+    /// `N` of the regularization schedule.
+    pub regularization_iterations: usize,
+}
+
+impl Default for SolveOptions {
+    fn default() -> Self {
+        SolveOptions {
+            max_iterations: 2000,
+            tolerance: 1e-5,
+            regularization: (5000.0, 5.0),
+            regularization_iterations: 400,
+        }
+    }
+}
+
+impl SolveOptions {
+    /// Settings for a warm start from a nearby solved state: the strong early regularization
+    /// exists to resolve the collisions of the affine start (A.2.3), which a warm start does not
+    /// have, so it starts at the schedule's end.
+    pub fn warm_started() -> Self {
+        let cold = SolveOptions::default();
+        SolveOptions { regularization: (cold.regularization.1, cold.regularization.1), ..cold }
+    }
+}
+
+/// Why a solve stopped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StopReason {
+    /// (A.33) holds.
+    Converged,
+    /// The iteration limit was reached first.
+    IterationLimit,
+    /// No step length decreased the energy.
+    LineSearchFailed,
+    /// The regularized system stayed indefinite.
+    FactorizationFailed,
+}
+
+/// What a solve did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolveReport {
+    /// Whether the equilibrium was found.
+    pub converged: bool,
+    /// Why it stopped.
+    pub reason: StopReason,
+    /// Newton iterations taken.
+    pub iterations: usize,
+    /// Tile energy at the end (J).
+    pub energy_j: f64,
+    /// Homogenized energy density (3.22): energy per undeformed tile area (J/m²).
+    pub energy_density_j_m2: f64,
+    /// Final projected gradient over its first value (A.33).
+    pub gradient_ratio: f64,
+    /// Largest constraint violation at the end.
+    pub constraint_residual: f64,
+    /// Symbolic factorizations computed (the rest reused the analysis).
+    pub symbolic_analyses: usize,
+}
+
+/// The constraint rows `C` (dense, few) of the tile under `placement`.
+fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f64> {
+    let n = model.dof_count();
+    let m = 3 + 2 * model.yarns.len();
+    let mut c = DMatrix::zeros(m, n);
+    for v in 0..model.vertices as u32 {
+        for k in 0..3 {
+            c[(k, model.position_dof(v) + k)] = 1.0;
+        }
+    }
+    let stretch = placement.in_plane_stretch();
+    for (y, yarn) in model.yarns.iter().enumerate() {
+        for &v in &yarn.vertices {
+            c[(3 + 2 * y, model.twist_dof(v))] = 1.0;
+        }
+        let closure = Vector2::new(f64::from(yarn.closure[0]), f64::from(yarn.closure[1]));
+        let normal = if closure.x.abs() >= closure.y.abs() { Vector2::x() } else { Vector2::y() };
+        let direction = (stretch * normal).normalize();
+        for k in 0..3 {
+            c[(4 + 2 * y, model.position_dof(yarn.boundary_vertex) + k)] = direction[k];
+        }
+    }
+    c
+}
+
+/// Gradient projected onto the tangent space of `C g = d` (A.31-A.32).
+fn projected(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
+    let cct = c * c.transpose();
+    let lambda = cct.lu().solve(&(c * gradient)).unwrap_or_else(|| DVector::zeros(c.nrows()));
+    gradient - c.transpose() * lambda
+}
+
+/// Find the tile's equilibrium from `state` (warm or affine start), updating it in place.
+pub fn solve(
+    model: &RveModel,
+    placement: &Placement,
+    state: &mut RveState,
+    options: &SolveOptions,
+) -> SolveReport {
+    let n = model.dof_count();
+    let r = model.radius_m;
+    let c = constraints(model, placement);
+    let target = &c * &state.g;
+    let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * r });
+    let c_scaled = &c * DMatrix::from_diagonal(&scale);
+    let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
+    let mut solver = SpdSolver::default();
+    let affine = RveState::affine(model, placement);
+    let first = projected(&c, &assemble(model, placement, &affine, &affine.g, Want::Derivatives).gradient)
+        .norm()
+        .max(f64::MIN_POSITIVE);
+    let mut current = assemble(model, placement, state, &state.g, Want::Derivatives);
+    let report =
+        |reason: StopReason, iterations: usize, energy: f64, ratio: f64, g: &DVector<f64>, analyses| {
+            SolveReport {
+                converged: reason == StopReason::Converged,
+                reason,
+                iterations,
+                energy_j: energy,
+                energy_density_j_m2: energy / model.area_m2(),
+                gradient_ratio: ratio,
+                constraint_residual: (&c * g - &target).amax(),
+                symbolic_analyses: analyses,
+            }
+        };
+    for iteration in 0..options.max_iterations {
+        let ratio = projected(&c, &current.gradient).norm() / first;
+        if ratio < options.tolerance {
+            return report(
+                StopReason::Converged,
+                iteration,
+                current.energy_j,
+                ratio,
+                &state.g,
+                solver.symbolic_analyses,
+            );
+        }
+        let (a0, an) = options.regularization;
+        let t = iteration.min(options.regularization_iterations) as f64
+            / options.regularization_iterations as f64;
+        let scaled_gradient = current.gradient.component_mul(&scale);
+        let mut alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
+        let scaled_hessian: Vec<(usize, usize, f64)> =
+            current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
+        let mut factored = false;
+        for _ in 0..30 {
+            if solver.factor(n, &scaled_hessian, alpha).is_ok() {
+                factored = true;
+                break;
+            }
+            alpha = (alpha * 10.0).max(1e-12);
+        }
+        if !factored {
+            return report(
+                StopReason::FactorizationFailed,
+                iteration,
+                current.energy_j,
+                ratio,
+                &state.g,
+                solver.symbolic_analyses,
+            );
+        }
+        let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
+            .component_mul(&scale);
+        let largest_move =
+            (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+        let mut length = if largest_move > p * r { p * r / largest_move } else { 1.0 };
+        let mut accepted = None;
+        for _ in 0..12 {
+            let trial = &state.g + &step * length;
+            let e = assemble(model, placement, state, &trial, Want::Energy).energy_j;
+            if e < current.energy_j {
+                accepted = Some(trial);
+                break;
+            }
+            length *= 0.1;
+        }
+        let Some(trial) = accepted else {
+            return report(
+                StopReason::LineSearchFailed,
+                iteration,
+                current.energy_j,
+                ratio,
+                &state.g,
+                solver.symbolic_analyses,
+            );
+        };
+        state.g = trial;
+        state.update_frames(model, placement);
+        current = assemble(model, placement, state, &state.g, Want::Derivatives);
+    }
+    let ratio = projected(&c, &current.gradient).norm() / first;
+    report(
+        StopReason::IterationLimit,
+        options.max_iterations,
+        current.energy_j,
+        ratio,
+        &state.g,
+        solver.symbolic_analyses,
+    )
+}
+
+/// The step of the regularized, constrained Newton system by the range-space method:
+/// `K w = -∇`, `K Y = Cᵀ`, `λ = (C Y)⁻¹ (C w + residual)`, step `w - Y λ` (so `C step = -residual`).
+fn constrained_step(
+    solver: &SpdSolver,
+    c: &DMatrix<f64>,
+    gradient: &DVector<f64>,
+    residual: &DVector<f64>,
+) -> DVector<f64> {
+    let n = gradient.len();
+    let mut w: Vec<f64> = gradient.iter().map(|x| -x).collect();
+    solver.solve_in_place(&mut w, 1);
+    let w = DVector::from_vec(w);
+    let mut y: Vec<f64> = c.transpose().as_slice().to_vec();
+    solver.solve_in_place(&mut y, c.nrows());
+    let y = DMatrix::from_vec(n, c.nrows(), y);
+    let lambda = (c * &y).lu().solve(&(c * &w + residual)).unwrap_or_else(|| DVector::zeros(c.nrows()));
+    w - y * lambda
+}

@@ -1,0 +1,109 @@
+//! The tile solver on the published patterns.
+
+use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
+use yarnhom_geom::MacroStrain;
+use yarnhom_rve::assembly::RveState;
+use yarnhom_rve::{Placement, RveModel, SolveOptions, SolveReport, solve};
+
+fn published(name: &str) -> Pattern {
+    let path = format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    parse_pyp(&text, name, None).expect("published pattern imports")
+}
+
+fn solve_at(model: &RveModel, strain: &str, start: Option<&RveState>) -> (SolveReport, RveState) {
+    let strain: MacroStrain = strain.parse().expect("strain");
+    let placement = Placement::new(model.material.clone(), model.period_m, &strain);
+    let mut state = match start {
+        Some(s) => {
+            let mut s = s.clone();
+            s.update_frames(model, &placement);
+            s
+        }
+        None => RveState::affine(model, &placement),
+    };
+    let options = if start.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
+    let report = solve(model, &placement, &mut state, &options);
+    (report, state)
+}
+
+fn stock() -> RveModel {
+    RveModel::new(&published("stock"), &YarnModel::table_4_1("stock").expect("row")).expect("tile")
+}
+
+#[test]
+fn stockinette_stretched_30_percent_reaches_equilibrium() {
+    let model = stock();
+    let strain: MacroStrain = "sx=0.3".parse().expect("strain");
+    let placement = Placement::new(model.material.clone(), model.period_m, &strain);
+    let affine = RveState::affine(&model, &placement);
+    let affine_energy = yarnhom_rve::assembly::assemble(
+        &model,
+        &placement,
+        &affine,
+        &affine.g,
+        yarnhom_rve::assembly::Want::Energy,
+    )
+    .energy_j;
+    let (report, _) = solve_at(&model, "sx=0.3", None);
+    assert!(report.converged, "{report:?}");
+    assert!(report.gradient_ratio < 1e-5);
+    assert!(report.constraint_residual < 1e-12, "constraints drifted: {report:?}");
+    assert!(report.energy_j < affine_energy, "relaxing must lower the energy of the affine start");
+    let (rest, _) = solve_at(&model, "sx=0", None);
+    assert!(report.energy_density_j_m2 > 5.0 * rest.energy_density_j_m2, "stretching stores energy");
+}
+
+#[test]
+fn a_warm_start_from_a_nearby_solution_needs_ten_times_fewer_iterations() {
+    let model = stock();
+    let (cold_nearby, nearby) = solve_at(&model, "sx=0.3", None);
+    let (warm, _) = solve_at(&model, "sx=0.31", Some(&nearby));
+    let (cold, _) = solve_at(&model, "sx=0.31", None);
+    assert!(cold_nearby.converged && warm.converged && cold.converged);
+    assert!(
+        10 * warm.iterations <= cold.iterations,
+        "warm {} vs cold {} iterations",
+        warm.iterations,
+        cold.iterations
+    );
+    let difference = (warm.energy_density_j_m2 / cold.energy_density_j_m2 - 1.0).abs();
+    assert!(difference < 1e-3, "warm and cold solves disagree by {difference}");
+}
+
+#[test]
+fn stockinette_curls_and_its_two_edges_curl_opposite_ways() {
+    // REFERENCES.md: edges parallel to courses roll one way, edges parallel to wales the other;
+    // so the energy minimum lies at non-zero curvature, of opposite signs about X1 and X2.
+    let model = stock();
+    let psi = |strain: &str| {
+        let (r, _) = solve_at(&model, strain, None);
+        assert!(r.converged, "{strain}: {r:?}");
+        r.energy_density_j_m2
+    };
+    let flat = psi("sx=0");
+    let (kx_minus, kx_plus) = (psi("kx=-40"), psi("kx=40"));
+    let (ky_minus, ky_plus) = (psi("ky=-40"), psi("ky=40"));
+    let curls_x = if kx_minus < flat {
+        -1.0
+    } else if kx_plus < flat {
+        1.0
+    } else {
+        0.0
+    };
+    let curls_y = if ky_minus < flat {
+        -1.0
+    } else if ky_plus < flat {
+        1.0
+    } else {
+        0.0
+    };
+    assert!(
+        curls_x != 0.0 && curls_y != 0.0,
+        "no curl: flat {flat}, kx {kx_minus}/{kx_plus}, ky {ky_minus}/{ky_plus}"
+    );
+    assert!(
+        curls_x * curls_y < 0.0,
+        "both edges curl the same way: kx {kx_minus}/{kx_plus}, ky {ky_minus}/{ky_plus}"
+    );
+}
