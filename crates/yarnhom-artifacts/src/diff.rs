@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::AnyArtifact;
 use crate::pattern::Pattern;
+use crate::rvesolve::RveSolve;
 use crate::yarnmodel::YarnModel;
 
 /// Tolerances of a comparison.
@@ -132,6 +133,7 @@ pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
     match (a, b) {
         (AnyArtifact::Pattern(a), AnyArtifact::Pattern(b)) => diff_patterns(a, b, tol),
         (AnyArtifact::YarnModel(a), AnyArtifact::YarnModel(b)) => diff_yarn_models(a, b, tol),
+        (AnyArtifact::RveSolve(a), AnyArtifact::RveSolve(b)) => diff_rve_solves(a, b, tol),
         _ => {
             let mut d = Diff::new(a.kind());
             d.structural.push(format!("kinds differ: {} vs {}", a.kind(), b.kind()));
@@ -206,5 +208,31 @@ pub fn diff_yarn_models(a: &YarnModel, b: &YarnModel, tol: Tolerance) -> Diff {
     for ((name, x), (_, y)) in pa.iter().zip(&pb) {
         d.values(name, &[*x], &[*y], tol);
     }
+    d
+}
+
+/// Compare two tile solves: strain, outcome, energy, stress and equilibrium geometry.
+pub fn diff_rve_solves(a: &RveSolve, b: &RveSolve, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("rvesolve");
+    for (what, x, y) in [("pattern", &a.pattern, &b.pattern), ("model", &a.model, &b.model)] {
+        if x != y {
+            d.notes.push(format!("{what}s differ: '{x}' vs '{y}'"));
+        }
+    }
+    if a.converged != b.converged {
+        d.structural.push(format!("converged: {} vs {}", a.converged, b.converged));
+    }
+    let strain = |s: &RveSolve| [s.strain.sx, s.strain.sa, s.strain.sy, s.strain.kx, s.strain.ky];
+    d.values("strain", &strain(a), &strain(b), tol);
+    if let (Some(x), Some(y)) = (a.energy_density_j_m2, b.energy_density_j_m2) {
+        d.values("energy_density_j_m2", &[x], &[y], tol);
+    }
+    match (a.stress_fd, b.stress_fd) {
+        (Some(x), Some(y)) => d.values("stress_fd", &x, &y, tol),
+        (None, None) => {}
+        _ => d.structural.push("stress present in only one file".into()),
+    }
+    d.rows("positions_m", &a.positions_m, &b.positions_m, tol);
+    d.values("edge_twist_rad", &a.edge_twist_rad, &b.edge_twist_rad, tol);
     d
 }

@@ -2,7 +2,8 @@
 //!
 //! - [`container`]: the versioned `.yh` framing shared by every kind (magic, header, zstd
 //!   msgpack payload, checksum), atomic writes, migrations of older schema versions.
-//! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`).
+//! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`),
+//!   [`rvesolve::RveSolve`] (`rvesolve`).
 //! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
@@ -15,6 +16,7 @@ pub mod error;
 pub mod hdf5;
 pub mod pattern;
 pub mod pyp;
+pub mod rvesolve;
 pub mod schema;
 pub mod yarnmodel;
 
@@ -23,6 +25,7 @@ use serde::{Deserialize, Serialize, de::DeserializeOwned};
 pub use container::{Header, InputRef, Producer, Provenance, RawArtifact};
 pub use error::{Error, Result, ValidationError};
 pub use pattern::{Fabric, Pattern, RestState, Yarn};
+pub use rvesolve::{RveSolve, StrainSample};
 pub use yarnmodel::{YarnMechanics, YarnModel};
 
 /// A kind of artifact: a serde type with a name, a schema version, invariants and migrations.
@@ -138,9 +141,21 @@ macro_rules! artifact_kinds {
     };
 }
 
+impl Artifact for RveSolve {
+    const KIND: &'static str = "rvesolve";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), ValidationError> {
+        RveSolve::validate(self)
+    }
+    fn summary(&self) -> String {
+        RveSolve::summary(self)
+    }
+}
+
 artifact_kinds! {
     Pattern => Pattern,
     YarnModel => YarnModel,
+    RveSolve => RveSolve,
 }
 
 impl AnyArtifact {

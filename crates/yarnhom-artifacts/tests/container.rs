@@ -188,8 +188,18 @@ proptest! {
     }
 
     #[test]
-    fn every_kind_round_trips_through_json(p in common::pattern(), m in common::yarn_model()) {
-        for a in [yarnhom_artifacts::AnyArtifact::Pattern(p), yarnhom_artifacts::AnyArtifact::YarnModel(m)] {
+    fn rve_solve_round_trips_through_the_container(r in common::rve_solve()) {
+        let bytes = encode(&r, &Provenance::default()).expect("encode");
+        prop_assert_eq!(decode::<yarnhom_artifacts::RveSolve>(&bytes).expect("decode").1, r);
+    }
+
+    #[test]
+    fn every_kind_round_trips_through_json(p in common::pattern(), m in common::yarn_model(), r in common::rve_solve()) {
+        for a in [
+            yarnhom_artifacts::AnyArtifact::Pattern(p),
+            yarnhom_artifacts::AnyArtifact::YarnModel(m),
+            yarnhom_artifacts::AnyArtifact::RveSolve(r),
+        ] {
             let bytes = a.encode(&Provenance::default()).expect("encode");
             let raw = container::decode_raw(&bytes).expect("raw");
             let doc = yarnhom_artifacts::JsonDocument { header: raw.header, payload: a.to_json().expect("json") };

@@ -10,6 +10,7 @@ mod inputs;
 mod inspect;
 mod model;
 mod pattern;
+mod rve;
 mod schema;
 
 use std::process::ExitCode;
@@ -36,6 +37,9 @@ enum Command {
     /// Yarn models: the built-in Table 4.1 parameter sets, written as `yarnmodel` artifacts.
     #[command(subcommand)]
     Model(model::ModelCommand),
+    /// The periodic yarn tile (thesis Ch. 3): equilibrium, homogenized energy and stress.
+    #[command(subcommand)]
+    Rve(rve::RveCommand),
     /// Describe an artifact: kind, schema version, provenance and a human summary.
     Inspect(inspect::InspectArgs),
     /// Convert an artifact between `.yh`, JSON, HDF5 and `.pyp`.
@@ -56,6 +60,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Pattern(cmd) => pattern::run(cmd),
         Command::Model(cmd) => model::run(cmd),
+        Command::Rve(cmd) => rve::run(cmd),
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Schema(args) => schema::run(args),

@@ -201,6 +201,8 @@ fn every_command_explains_itself() {
         &["convert"],
         &["schema"],
         &["diff"],
+        &["rve"],
+        &["rve", "solve"],
     ];
     for cmd in commands {
         let mut args = cmd.to_vec();
@@ -209,4 +211,67 @@ fn every_command_explains_itself() {
         assert!(text.contains("Usage:"), "{cmd:?} --help:\n{text}");
         assert!(text.lines().next().is_some_and(|l| l.len() > 20), "{cmd:?} has no description:\n{text}");
     }
+}
+
+#[test]
+fn rve_solve_reports_energy_and_stress_and_refuses_bad_input() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tiny = format!("{DATA}/stocktiniest.pyp");
+    let out = dir.path().join("tiny.rvesolve.yh");
+    let out_s = out.to_str().expect("utf8");
+    let text = ok(
+        &[
+            "rve",
+            "solve",
+            &tiny,
+            "--model",
+            "table4.1:stock-small",
+            "--strain",
+            "sx=0.2,sy=-0.05",
+            "-o",
+            out_s,
+        ],
+        dir.path(),
+    );
+    assert!(text.contains("converged after"), "{text}");
+    assert!(text.contains("stress (finite differences)"), "{text}");
+    let (_, solved) = container::read::<yarnhom_artifacts::RveSolve>(&out).expect("rvesolve reads back");
+    assert!(solved.converged && solved.energy_density_j_m2.is_some_and(|e| e > 0.0));
+    assert_eq!(solved.positions_m.len(), 13);
+    assert_eq!(yarnhom(&["diff", out_s, out_s], dir.path()).status.code(), Some(0));
+    fails_with(
+        &["rve", "solve", &tiny, "--model", "table4.1:stock-small", "--strain", "sa=1"],
+        dir.path(),
+        "|sa| < 1",
+    );
+    fails_with(
+        &["rve", "solve", &tiny, "--model", "table4.1:stock-small", "--strain", "sx=-1.5"],
+        dir.path(),
+        "must be > -1",
+    );
+    fails_with(
+        &["rve", "solve", &tiny, "--model", "table4.1:stock-small", "--strain", "sq=1"],
+        dir.path(),
+        "unknown parameter 'sq'",
+    );
+    fails_with(
+        &["rve", "solve", &tiny, "--model", "table4.1:stock", "--strain", "sx=0.1"],
+        dir.path(),
+        "differs from the pattern's yarn radius",
+    );
+    let generated = dir.path().join("g.pattern.yh");
+    ok(&["pattern", "generate", "stockinette", "-o", generated.to_str().expect("utf8")], dir.path());
+    fails_with(
+        &[
+            "rve",
+            "solve",
+            generated.to_str().expect("utf8"),
+            "--model",
+            "table4.1:stock",
+            "--strain",
+            "sx=0.1",
+        ],
+        dir.path(),
+        "has no rest state",
+    );
 }

@@ -310,3 +310,10 @@ pub fn bend_energies(model: &RveModel, placement: &Placement, state: &RveState) 
         })
         .collect()
 }
+
+/// World positions of the tile's vertices at the state's DOFs.
+pub fn world_positions(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<[f64; 3]> {
+    (0..model.vertices as u32)
+        .map(|v| position_of(model, placement, &state.g, Instance { vertex: v, image: [0, 0] }).into())
+        .collect()
+}

@@ -11,9 +11,11 @@
 //! - [`placement`]: where vertex instances go under a macro strain;
 //! - [`assembly`]: energy, gradient and Hessian over `g`;
 //! - [`solve`]: the constrained Newton solve for the tile's equilibrium;
-//! - [`linear`]: sparse Cholesky with reused symbolic analysis.
+//! - [`linear`]: sparse Cholesky with reused symbolic analysis;
+//! - [`homogenize`]: energy density and stress at a macro strain.
 
 pub mod assembly;
+pub mod homogenize;
 pub mod linear;
 pub mod model;
 pub mod placement;

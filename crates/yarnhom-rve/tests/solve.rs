@@ -3,7 +3,7 @@
 use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::assembly::RveState;
-use yarnhom_rve::{Placement, RveModel, SolveOptions, SolveReport, solve};
+use yarnhom_rve::{Placement, RveModel, SolveOptions, SolveReport};
 
 fn published(name: &str) -> Pattern {
     let path = format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
@@ -13,18 +13,8 @@ fn published(name: &str) -> Pattern {
 
 fn solve_at(model: &RveModel, strain: &str, start: Option<&RveState>) -> (SolveReport, RveState) {
     let strain: MacroStrain = strain.parse().expect("strain");
-    let placement = Placement::new(model.material.clone(), model.period_m, &strain);
-    let mut state = match start {
-        Some(s) => {
-            let mut s = s.clone();
-            s.update_frames(model, &placement);
-            s
-        }
-        None => RveState::affine(model, &placement),
-    };
     let options = if start.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
-    let report = solve(model, &placement, &mut state, &options);
-    (report, state)
+    yarnhom_rve::homogenize::solve_at(model, &strain, start, &options)
 }
 
 fn stock() -> RveModel {

@@ -2,7 +2,7 @@
 #![allow(dead_code, missing_docs)]
 
 use proptest::prelude::*;
-use yarnhom_artifacts::{Fabric, Pattern, RestState, Yarn, YarnMechanics, YarnModel};
+use yarnhom_artifacts::{Fabric, Pattern, RestState, RveSolve, StrainSample, Yarn, YarnMechanics, YarnModel};
 
 fn finite(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     lo..hi
@@ -130,4 +130,39 @@ pub fn yarn_model() -> impl Strategy<Value = YarnModel> {
     (finite(1e-5, 1e-2), finite(10.0, 2e3), prop_oneof![rod, biphasic]).prop_map(|(r, rho, mechanics)| {
         YarnModel { name: "random".into(), radius_m: r, density_kg_m3: rho, mechanics }
     })
+}
+
+/// A valid tile solve, converged or not.
+pub fn rve_solve() -> impl Strategy<Value = RveSolve> {
+    (prop::collection::vec(-0.5f64..2.0, 5), any::<bool>(), 1usize..20, any::<bool>()).prop_flat_map(
+        |(s, converged, n, stress)| {
+            (
+                Just((s, converged, stress)),
+                prop::collection::vec(prop::array::uniform3(-0.01f64..0.01), n),
+                prop::collection::vec(-3.0f64..3.0, n),
+                0.0f64..10.0,
+                prop::array::uniform5(-10.0f64..10.0),
+            )
+                .prop_map(|((s, converged, stress), positions, twists, energy, st)| RveSolve {
+                    pattern: "p".into(),
+                    model: "m".into(),
+                    strain: StrainSample {
+                        sx: s[0],
+                        sa: s[1] / 3.0,
+                        sy: s[2],
+                        kx: s[3] * 50.0,
+                        ky: s[4] * 50.0,
+                    },
+                    converged,
+                    stop_reason: if converged { "converged".into() } else { "iteration_limit".into() },
+                    energy_density_j_m2: converged.then_some(energy),
+                    stress_fd: (converged && stress).then_some(st),
+                    iterations: 7,
+                    gradient_ratio: 1e-6,
+                    seconds: 0.5,
+                    positions_m: positions,
+                    edge_twist_rad: twists,
+                })
+        },
+    )
 }

@@ -1,0 +1,140 @@
+//! `yarnhom rve ...`: the periodic yarn tile (thesis Ch. 3).
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, container};
+use yarnhom_geom::MacroStrain;
+use yarnhom_rve::homogenize::{solve_at, stress_by_finite_differences};
+use yarnhom_rve::{RveModel, SolveOptions, StopReason};
+
+use crate::Outcome;
+use crate::inputs::{self, base_name, provenance};
+
+#[derive(Debug, Subcommand)]
+pub enum RveCommand {
+    /// Solve the tile's elastostatic equilibrium under a macro strain and report the homogenized
+    /// energy density (3.22) and stress.
+    ///
+    /// The pattern needs a rest state (the published `.pyp` patterns have one). Exit status 0
+    /// when the solve converged, 1 when it did not (the artifact is written anyway and says so,
+    /// with no energy), 2 on bad input.
+    Solve(SolveArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SolveArgs {
+    /// The pattern (`.yh`, JSON, HDF5 or `.pyp`).
+    pub pattern: PathBuf,
+    /// Yarn model: a built-in `table4.1:<row>` (see `yarnhom model list`) or a `yarnmodel` file.
+    #[arg(long)]
+    pub model: String,
+    /// Macro strain `sx=..,sa=..,sy=..,kx=..,ky=..` (omitted ones are 0): stretches along X1, X2
+    /// (`> -1`), shear `sa` (the cosine of the deformed axes' angle, `|sa| < 1`), curvatures (1/m).
+    #[arg(long, allow_hyphen_values = true)]
+    pub strain: String,
+    /// Skip the finite-difference stress (ten extra warm-started solves).
+    #[arg(long)]
+    pub no_stress: bool,
+    /// Newton iteration limit.
+    #[arg(long, default_value_t = 2000)]
+    pub max_iterations: usize,
+    /// Output file (default: <pattern>.rvesolve.yh).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
+    match cmd {
+        RveCommand::Solve(args) => solve(args),
+    }
+}
+
+/// A built-in `table4.1:<row>` model or a `yarnmodel` file.
+fn load_model(spec: &str) -> anyhow::Result<(YarnModel, Option<yarnhom_artifacts::InputRef>)> {
+    if let Some(row) = spec.strip_prefix("table4.1:") {
+        return Ok((crate::model::builtin(row)?, None));
+    }
+    let loaded = inputs::load(std::path::Path::new(spec), None)?;
+    let input = yarnhom_artifacts::InputRef {
+        kind: "yarnmodel".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: spec.into(),
+    };
+    match loaded.artifact {
+        AnyArtifact::YarnModel(m) => Ok((m, Some(input))),
+        other => anyhow::bail!("{spec}: holds a '{}', not a yarnmodel", other.kind()),
+    }
+}
+
+fn stop_reason(reason: StopReason) -> &'static str {
+    match reason {
+        StopReason::Converged => "converged",
+        StopReason::IterationLimit => "iteration_limit",
+        StopReason::LineSearchFailed => "line_search_failed",
+        StopReason::FactorizationFailed => "factorization_failed",
+    }
+}
+
+fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
+    let strain: MacroStrain = args.strain.parse()?;
+    let loaded = inputs::load(&args.pattern, None)?;
+    let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
+        anyhow::bail!("{}: holds a '{}', not a pattern", args.pattern.display(), loaded.artifact.kind())
+    };
+    let (model, model_input) = load_model(&args.model)?;
+    let tile = RveModel::new(pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
+    let options = SolveOptions { max_iterations: args.max_iterations, ..SolveOptions::default() };
+    eprintln!(
+        "solving '{}' ({} vertices) with '{}' at {}",
+        pattern.name,
+        pattern.vertex_count(),
+        model.name,
+        args.strain
+    );
+    let started = Instant::now();
+    let (report, state) = solve_at(&tile, &strain, None, &options);
+    let seconds = started.elapsed().as_secs_f64();
+    let stress = (report.converged && !args.no_stress)
+        .then(|| stress_by_finite_differences(&tile, &strain, &state))
+        .flatten();
+    let placement = yarnhom_rve::homogenize::placement(&tile, &strain);
+    let result = RveSolve {
+        pattern: pattern.name.clone(),
+        model: model.name.clone(),
+        strain: StrainSample {
+            sx: strain.s.sx,
+            sa: strain.s.sa,
+            sy: strain.s.sy,
+            kx: strain.kx,
+            ky: strain.ky,
+        },
+        converged: report.converged,
+        stop_reason: stop_reason(report.reason).into(),
+        energy_density_j_m2: report.converged.then_some(report.energy_density_j_m2),
+        stress_fd: stress,
+        iterations: report.iterations as u32,
+        gradient_ratio: report.gradient_ratio,
+        seconds,
+        positions_m: yarnhom_rve::assembly::world_positions(&tile, &placement, &state),
+        edge_twist_rad: (0..tile.vertices as u32).map(|v| state.g[tile.twist_dof(v)]).collect(),
+    };
+    let output = args.output.unwrap_or_else(|| format!("{}.rvesolve.yh", base_name(&args.pattern)).into());
+    let mut inputs_list = vec![yarnhom_artifacts::InputRef {
+        kind: "pattern".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: args.pattern.display().to_string(),
+    }];
+    inputs_list.extend(model_input);
+    container::write(&output, &result, &provenance("rve solve", inputs_list))?;
+    println!("{}", result.summary());
+    eprintln!("wrote {}", output.display());
+    if report.converged {
+        Ok(Outcome::Success)
+    } else {
+        eprintln!("error: the solve did not converge ({})", stop_reason(report.reason));
+        Ok(Outcome::Different)
+    }
+}
