@@ -1,0 +1,51 @@
+//! Wall time of one periodic tile solve (thesis Ch. 3) on the published patterns with their
+//! Table 4.1 yarn models, cold (affine start) and warm-started from the solution at a nearby
+//! strain (1% more stretch or curvature).
+//! Compared with: thesis Table A.1, about 5.7 thread-seconds per sample for stockinette and 25
+//! for rib; yarnhom's target is under 0.2 s per cold stock solve on one core.
+//! Set `YARNHOM_BENCH_RIB=1` to include rib (about 16 s per cold solve).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
+use yarnhom_geom::MacroStrain;
+use yarnhom_rve::homogenize::solve_at;
+use yarnhom_rve::{RveModel, SolveOptions};
+
+fn tile(name: &str) -> RveModel {
+    let path = format!("{}/../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let pattern = parse_pyp(&text, name, None).expect("published pattern");
+    RveModel::new(&pattern, &YarnModel::table_4_1(name).expect("Table 4.1 row")).expect("tile")
+}
+
+fn bench_solves(c: &mut Criterion) {
+    let mut names = vec!["stock"];
+    if std::env::var("YARNHOM_BENCH_RIB").is_ok() {
+        names.push("rib");
+    }
+    let mut g = c.benchmark_group("rve solve");
+    g.sample_size(10);
+    for name in names {
+        let model = tile(name);
+        for (label, strain, nearby) in [("sx=0.3", "sx=0.3", "sx=0.303"), ("kx=40", "kx=40", "kx=40.4")] {
+            let strain: MacroStrain = strain.parse().expect("strain");
+            let nearby: MacroStrain = nearby.parse().expect("strain");
+            let (cold, solved) = solve_at(&model, &strain, None, &SolveOptions::default());
+            let (warm, _) = solve_at(&model, &nearby, Some(&solved), &SolveOptions::warm_started());
+            eprintln!(
+                "{name} {label}: {} vertices, {} iterations cold, {} warm; converged {} {}",
+                model.vertices, cold.iterations, warm.iterations, cold.converged, warm.converged
+            );
+            g.bench_function(format!("{name} {label} cold"), |b| {
+                b.iter(|| solve_at(&model, &strain, None, &SolveOptions::default()))
+            });
+            g.bench_function(format!("{name} {label} warm"), |b| {
+                b.iter(|| solve_at(&model, &nearby, Some(&solved), &SolveOptions::warm_started()))
+            });
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench_solves);
+criterion_main!(benches);
