@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's main command: yarnhom's pipeline on built-in defaults, printing where each
-# artifact went. Today it covers the foundation stage: published and generated patterns, the
-# Table 4.1 yarn models, inspection, conversion (JSON, HDF5, .pyp) and semantic diff. Later
+# artifact went. Today: published and generated patterns, the Table 4.1 yarn models,
+# inspection, conversion (JSON, HDF5, .pyp), a periodic tile solve and semantic diff. Later
 # stages (relax -> sample -> fit -> simulate) join it as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -30,6 +30,9 @@ echo "== conversions of the rib pattern"
 yarnhom convert "$out/rib.pattern.yh" --to json -o "$out/rib.pattern.json"
 yarnhom convert "$out/rib.pattern.yh" --to hdf5 -o "$out/rib.pattern.h5"
 yarnhom convert "$out/rib.pattern.yh" --to pyp -o "$out/rib.pyp"
+
+echo "== periodic tile solve: the published stockinette stretched 30% along X1 -> $out/stock-sx0.3.rvesolve.yh"
+yarnhom rve solve "$data/stock.pyp" --model table4.1:stock --strain sx=0.3 -o "$out/stock-sx0.3.rvesolve.yh"
 
 echo "== semantic diff: the HDF5 export against the original (equal), stockinette against rib (different)"
 yarnhom diff "$out/rib.pattern.yh" "$out/rib.pattern.h5"
