@@ -1,6 +1,12 @@
 //! Smooth periodic curves: B-spline sampling, arc length, resampling, and the over/under
 //! undulation of a yarn through its crossings.
 
+/// Height of yarn crossings above and below the mid-plane, in yarn radii: crossing centrelines
+/// are `2 * 1.05 r` apart.
+pub const LEVEL_R: f64 = 1.05;
+/// Fraction of each gap between crossings over which a yarn stays level.
+pub const PLATEAU: f64 = 0.15;
+
 /// Sample a uniform cubic B-spline through a periodic control polygon whose point `i + n` is
 /// point `i` shifted by `shift` (one tile), `samples_per_span` points per control span.
 pub fn periodic_bspline(control: &[[f64; 2]], shift: [f64; 2], samples_per_span: usize) -> Vec<[f64; 2]> {

@@ -22,7 +22,7 @@ use nalgebra::Vector2;
 use yarnhom_artifacts::{Fabric, Pattern};
 use yarnhom_geom::segment_crossing_2d;
 
-use crate::curve::{arc_lengths, periodic_bspline, resample, undulate};
+use crate::curve::{LEVEL_R, PLATEAU, arc_lengths, periodic_bspline, resample, undulate};
 use crate::{GenerateError, GeneratorParams, add_yarn};
 
 /// Knit or purl, as seen from the front (+X3).
@@ -53,10 +53,6 @@ const SHAPE_HEIGHT_R: f64 = OVERLAP_R + NECK_HEIGHT_R;
 pub const MIN_WIDTH_R: f64 = 12.5;
 /// Smallest course height, in yarn radii (as [`MIN_WIDTH_R`]).
 pub const MIN_HEIGHT_R: f64 = 7.5;
-/// Height of the crossings above and below the mid-plane, in radii (centrelines cross 2.1 r apart).
-const LEVEL_R: f64 = 1.05;
-/// Fraction of each gap between crossings over which the yarn stays level.
-const PLATEAU: f64 = 0.15;
 /// B-spline samples per control span (the plan view used to find crossings).
 const SAMPLES_PER_SPAN: usize = 40;
 /// Control points per stitch.

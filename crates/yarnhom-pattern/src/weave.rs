@@ -5,13 +5,9 @@
 
 use yarnhom_artifacts::{Fabric, Pattern};
 
-use crate::curve::{resample, undulate};
+use crate::curve::{LEVEL_R, PLATEAU, resample, undulate};
 use crate::{GenerateError, GeneratorParams, add_yarn};
 
-/// Height of the crossings above and below the mid-plane, in radii.
-const LEVEL_R: f64 = 1.05;
-/// Fraction of each gap between crossings over which a yarn stays level.
-const PLATEAU: f64 = 0.15;
 /// Smallest spacing of parallel yarns, in radii: below it the yarns' slopes between crossings
 /// bring crossing yarns closer than 1.9 radii (3.0 r gives 1.83 r, 3.5 r gives 2.03 r).
 pub const MIN_SPACING_R: f64 = 3.4;

@@ -35,15 +35,18 @@ fn rib_is_strongly_anisotropic() {
 fn honeycomb_contracts_sideways_when_stretched() {
     // Poisson effect: at sx = 0.3 the energy-minimizing sy is negative.
     let honey = tile("honey");
-    let (minus, zero, plus) = (psi(&honey, "sx=0.3,sy=-0.05"), psi(&honey, "sx=0.3"), psi(&honey, "sx=0.3,sy=0.05"));
+    let (minus, zero, plus) =
+        (psi(&honey, "sx=0.3,sy=-0.05"), psi(&honey, "sx=0.3"), psi(&honey, "sx=0.3,sy=0.05"));
     assert!(minus < zero && zero < plus, "honey at sx=0.3: sy=-0.05 {minus}, 0 {zero}, +0.05 {plus}");
 }
 
 #[test]
 #[ignore = "heavy"]
 fn woven_fabrics_are_stiffer_in_stretch_than_knits() {
-    let knits: Vec<f64> = ["stock", "honey"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
-    let wovens: Vec<f64> = ["basket", "satin"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
+    let knits: Vec<f64> =
+        ["stock", "honey"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
+    let wovens: Vec<f64> =
+        ["basket", "satin"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
     let softest_woven = wovens.iter().cloned().fold(f64::INFINITY, f64::min);
     let stiffest_knit = knits.iter().cloned().fold(0.0, f64::max);
     assert!(softest_woven > stiffest_knit, "stretch energy at sx=0.1: knits {knits:?}, wovens {wovens:?}");
