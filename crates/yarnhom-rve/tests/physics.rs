@@ -40,14 +40,56 @@ fn honeycomb_contracts_sideways_when_stretched() {
     assert!(minus < zero && zero < plus, "honey at sx=0.3: sy=-0.05 {minus}, 0 {zero}, +0.05 {plus}");
 }
 
+/// The published HYLC fit's 1D term `k` (0 = sx) at strain `x`: a cubic Hermite spline over
+/// `strain / strain scale`, extrapolated linearly (../shared/data/hylc-materials/FORMAT.md).
+fn published_term(name: &str, k: usize, x: f64) -> f64 {
+    let path = format!("{}/../../../shared/data/hylc-materials/{name}1.json", env!("CARGO_MANIFEST_DIR"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).expect("fit")).expect("json");
+    let scale = json["strain scale"][k].as_f64().expect("scale");
+    let term = json["coeffs"]["1D"].as_array().expect("1D terms").iter().find(|t| t["k"] == k).expect("term");
+    let v = |key: &str| -> Vec<f64> {
+        term[key].as_array().expect(key).iter().map(|x| x.as_f64().expect("number")).collect()
+    };
+    let (t, p, m) = (v("t"), v("p"), v("m"));
+    let u = x / scale;
+    let last = t.len() - 1;
+    if u <= t[0] {
+        return p[0] + m[0] * (u - t[0]);
+    }
+    if u >= t[last] {
+        return p[last] + m[last] * (u - t[last]);
+    }
+    let i = t.iter().position(|&ti| ti > u).expect("inside") - 1;
+    let h = t[i + 1] - t[i];
+    let s = (u - t[i]) / h;
+    let (s2, s3) = (s * s, s * s * s);
+    (2.0 * s3 - 3.0 * s2 + 1.0) * p[i]
+        + (s3 - 2.0 * s2 + s) * h * m[i]
+        + (-2.0 * s3 + 3.0 * s2) * p[i + 1]
+        + (s3 - s2) * h * m[i + 1]
+}
+
 #[test]
 #[ignore = "heavy"]
-fn woven_fabrics_are_stiffer_in_stretch_than_knits() {
-    let knits: Vec<f64> =
-        ["stock", "honey"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
-    let wovens: Vec<f64> =
-        ["basket", "satin"].iter().map(|n| psi(&tile(n), "sx=0.1") - psi(&tile(n), "sx=0")).collect();
-    let softest_woven = wovens.iter().cloned().fold(f64::INFINITY, f64::min);
-    let stiffest_knit = knits.iter().cloned().fold(0.0, f64::max);
-    assert!(softest_woven > stiffest_knit, "stretch energy at sx=0.1: knits {knits:?}, wovens {wovens:?}");
+fn stretch_response_matches_the_published_fits() {
+    // Energy added by stretching 30% along X1, ours (solve at sx=0.3 minus sx=0) against the
+    // published fit's 1D sx term: same ranking across patterns and each within 30%.
+    // (Measured: stock +24%, satin +13%, basket -9%, honey +25%.)
+    let names = ["stock", "satin", "basket", "honey"];
+    let mut ours = Vec::new();
+    for name in names {
+        let t = tile(name);
+        let added = psi(&t, "sx=0.3") - psi(&t, "sx=0");
+        let published = published_term(name, 0, 0.3) - published_term(name, 0, 0.0);
+        println!(
+            "{name}: ours {added:.4}, published {published:.4} J/m², {:+.1}%",
+            100.0 * (added / published - 1.0)
+        );
+        assert!((added / published - 1.0).abs() < 0.3, "{name}: ours {added}, published {published}");
+        ours.push((added, published));
+    }
+    for w in ours.windows(2) {
+        assert!(w[0].0 > w[1].0 && w[0].1 > w[1].1, "ranking differs: {ours:?}");
+    }
 }
