@@ -3,7 +3,7 @@
 //! Every element is evaluated on world positions of vertex instances; derivatives are pulled
 //! back to the tile DOFs through `x = ... + R(X) g`: `∇_g = Rᵀ ∇_x`, `H_gg' = Rᵀ H_xx' R'`.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DVector, Matrix3, Vector3};
 use yarnhom_pattern::min_distance::lower_bound;
 use yarnhom_rod::{
     BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
@@ -152,7 +152,9 @@ fn reference_twists(model: &RveModel, placement: &Placement, state: &RveState) -
         .collect()
 }
 
-/// Pull an element's derivatives back to the tile DOFs and add them in.
+/// Pull an element's derivatives back to the tile DOFs and add them in, block by block:
+/// position blocks are rotated by the instances' `R` (`∇_g = Rᵀ ∇_x`, `H_gg' = Rᵀ H R'`),
+/// twist entries pass through. No allocation beyond the Hessian triplets.
 struct Scatter<'a> {
     model: &'a RveModel,
     placement: &'a Placement,
@@ -160,28 +162,55 @@ struct Scatter<'a> {
 }
 
 impl Scatter<'_> {
-    /// `instances`: the element's vertices (3 local DOFs each, first); `twists`: the source
-    /// vertices of its twisted edges (1 local DOF each, after the positions).
-    fn add(&mut self, instances: &[Instance], twists: &[u32], g: &[f64], h: Option<&DMatrix<f64>>) {
-        let k = 3 * instances.len() + twists.len();
-        let mut t = DMatrix::<f64>::identity(k, k);
-        let mut index = Vec::with_capacity(k);
+    /// `instances`: the element's vertices (3 local DOFs each, first; at most 4); `twists`: the
+    /// source vertices of its twisted edges (1 local DOF each, after the positions); `h`: the
+    /// local Hessian, column-major.
+    fn add(&mut self, instances: &[Instance], twists: &[u32], g: &[f64], h: Option<&[f64]>) {
+        let np = instances.len();
+        let k = 3 * np + twists.len();
+        let mut rotation = [Matrix3::identity(); 4];
+        let mut base = [0usize; 4];
         for (i, inst) in instances.iter().enumerate() {
-            t.fixed_view_mut::<3, 3>(3 * i, 3 * i).copy_from(&self.placement.rotation(*inst));
-            let base = self.model.position_dof(inst.vertex);
-            index.extend([base, base + 1, base + 2]);
+            rotation[i] = self.placement.rotation(*inst);
+            base[i] = self.model.position_dof(inst.vertex);
+            let local = rotation[i].transpose() * Vector3::new(g[3 * i], g[3 * i + 1], g[3 * i + 2]);
+            for c in 0..3 {
+                self.out.gradient[base[i] + c] += local[c];
+            }
         }
-        index.extend(twists.iter().map(|&e| self.model.twist_dof(e)));
-        let gl = t.transpose() * DVector::from_column_slice(g);
-        for (a, &i) in index.iter().enumerate() {
-            self.out.gradient[i] += gl[a];
+        let twist_index = |t: usize| self.model.twist_dof(twists[t]);
+        for (t, &value) in g[3 * np..].iter().enumerate() {
+            self.out.gradient[twist_index(t)] += value;
         }
-        if let Some(h) = h {
-            let hl = t.transpose() * h * &t;
-            for (a, &i) in index.iter().enumerate() {
-                for (b, &j) in index.iter().enumerate() {
-                    self.out.hessian.push((i, j, hl[(a, b)]));
+        let Some(h) = h else { return };
+        let at = |row: usize, col: usize| h[col * k + row];
+        let block = |i: usize, j: usize| Matrix3::from_fn(|r, c| at(3 * i + r, 3 * j + c));
+        let hessian = &mut self.out.hessian;
+        for i in 0..np {
+            for j in 0..np {
+                let pulled = rotation[i].transpose() * block(i, j) * rotation[j];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        hessian.push((base[i] + r, base[j] + c, pulled[(r, c)]));
+                    }
                 }
+            }
+            for t in 0..twists.len() {
+                let column = rotation[i].transpose()
+                    * Vector3::new(
+                        at(3 * i, 3 * np + t),
+                        at(3 * i + 1, 3 * np + t),
+                        at(3 * i + 2, 3 * np + t),
+                    );
+                for r in 0..3 {
+                    hessian.push((base[i] + r, twist_index(t), column[r]));
+                    hessian.push((twist_index(t), base[i] + r, column[r]));
+                }
+            }
+        }
+        for t in 0..twists.len() {
+            for u in 0..twists.len() {
+                hessian.push((twist_index(t), twist_index(u), at(3 * np + t, 3 * np + u)));
             }
         }
     }
@@ -203,8 +232,8 @@ pub fn assemble(
         let (e, grad, hess) =
             stretch_energy(&model.material_law.stretch, s.rest_length_m, &position(s.from), &position(s.to));
         out.energy_j += e;
-        let h = derivatives.then(|| DMatrix::from_column_slice(6, 6, hess.as_slice()));
-        Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h.as_ref());
+        let h = derivatives.then_some(hess.as_slice());
+        Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h);
     }
     for (k, b) in model.bends.iter().enumerate() {
         let reference = bend_reference(placement, state, b, k);
@@ -213,12 +242,11 @@ pub fn assemble(
         if derivatives {
             let (e, grad, hess) = b.element.energy_gradient_hessian(&reference, &q);
             out.energy_j += e;
-            let h = DMatrix::from_column_slice(11, 11, hess.as_slice());
             Scatter { model, placement, out: &mut out }.add(
                 &[b.prev, b.vertex, b.next],
                 &twists,
                 grad.as_slice(),
-                Some(&h),
+                Some(hess.as_slice()),
             );
         } else {
             out.energy_j += b.element.energy(&reference, &q);
@@ -285,14 +313,9 @@ fn add_contacts(
                     continue;
                 }
                 out.energy_j += e;
-                let h = derivatives.then(|| DMatrix::from_column_slice(12, 12, hess.as_slice()));
+                let h = derivatives.then_some(hess.as_slice());
                 let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
-                Scatter { model, placement, out: &mut *out }.add(
-                    &instances,
-                    &[],
-                    grad.as_slice(),
-                    h.as_ref(),
-                );
+                Scatter { model, placement, out: &mut *out }.add(&instances, &[], grad.as_slice(), h);
             }
         }
     }
