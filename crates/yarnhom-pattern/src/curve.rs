@@ -2,8 +2,10 @@
 //! undulation of a yarn through its crossings.
 
 /// Height of yarn crossings above and below the mid-plane, in yarn radii: crossing centrelines
-/// are `2 * 1.05 r` apart.
-pub const LEVEL_R: f64 = 1.05;
+/// are `3 r` apart. The margin over touching (`2 r`) is what lets a yarn change sides between
+/// two crossings close together (a weave's neighbouring yarns, a loop's leg between the head
+/// below and the sinker above) without coming within 1.9 r of either.
+pub const LEVEL_R: f64 = 1.5;
 /// Fraction of each gap between crossings over which a yarn stays level.
 pub const PLATEAU: f64 = 0.15;
 

@@ -12,11 +12,17 @@
 //! 3. at each crossing one yarn passes over (+Z) and the other under (-Z), as the stitch type of
 //!    the upper loop says (knit: upper legs in front of the lower head, upper sinker behind its
 //!    sides; purl: the mirror image);
-//! 4. the height along each yarn follows [`undulate`] through its crossings, and the curve is
+//! 4. the height along each yarn follows `curve::undulate` through its crossings, and the curve is
 //!    resampled to equal edge lengths.
 //!
-//! The control polygon's proportions are set in units of the yarn radius and scaled to the
-//! requested stitch size; the smallest stitch is [`MIN_WIDTH_R`] x [`MIN_HEIGHT_R`] radii.
+//! The control polygon's proportions are set in units of the yarn radius and scaled (separately
+//! along X1 and X2) to the requested stitch size, so the plan view of every stitch size is an
+//! affine image of the smallest one and crosses its neighbours at the same curve parameters.
+//! Where knit and purl loops meet, a yarn changes sides between two nearby crossings and the
+//! loops get more room: wider head gaps between knit and purl wales, taller necks between knit
+//! and purl courses. The smallest stitch is [`min_stitch_r`]: 8.4 x 4.4 radii for stockinette,
+//! 8.4 x 5.6 for garter, 9.4 x 4.4 for rib, 9.4 x 5.6 for seed (the published relaxed
+//! stockinette has 7.5 x 4.0 radii per stitch).
 
 use nalgebra::Vector2;
 use yarnhom_artifacts::{Fabric, Pattern};
@@ -35,36 +41,79 @@ pub enum Stitch {
 }
 
 /// Inner width of a loop's neck between its legs, in radii.
-const NECK_R: f64 = 3.0;
+const NECK_R: f64 = 1.8;
 /// How far a head bulges out beyond its legs on each side, in radii.
-const BULGE_R: f64 = 2.2;
-/// Gap between the heads of neighbouring loops, in radii.
-const GAP_R: f64 = 2.2;
+const BULGE_R: f64 = 2.4;
+/// Gap between the heads of neighbouring loops of the same kind, in radii.
+const GAP_R: f64 = 1.8;
+/// Gap between the heads of a knit and a purl loop side by side, in radii: the sinker above
+/// passes behind one head's leg and in front of the other's, and needs room to change sides.
+const GAP_SWITCH_R: f64 = 2.8;
 /// How far a head reaches into the course above, in radii.
-const OVERLAP_R: f64 = 3.0;
-/// Height of the neck region (sinker-to-head transition), in radii.
-const NECK_HEIGHT_R: f64 = 2.0;
-/// Width of the control polygon's stitch in its own units (radii before scaling).
-const SHAPE_WIDTH_R: f64 = NECK_R + 2.0 * BULGE_R + GAP_R;
-/// Height of the control polygon's course in its own units.
-const SHAPE_HEIGHT_R: f64 = OVERLAP_R + NECK_HEIGHT_R;
-/// Smallest stitch width, in yarn radii: narrower stitches bring loops of neighbouring wales
-/// closer than 1.9 r (found by scanning all four knits; `tests/generators.rs` checks the bound).
-pub const MIN_WIDTH_R: f64 = 12.5;
-/// Smallest course height, in yarn radii (as [`MIN_WIDTH_R`]).
-pub const MIN_HEIGHT_R: f64 = 7.5;
+const OVERLAP_R: f64 = 2.6;
+/// Height of the neck region (sinker-to-head transition) between the crossings with the head
+/// below and the sinker above, in radii. It is also the plan-view gap between a head and the
+/// sinker two courses up, which lie on the same side of the fabric beside the leg between them.
+const NECK_HEIGHT_R: f64 = 1.8;
+/// Neck height of a loop whose legs change sides (a knit under a purl or vice versa): in front
+/// of the head below and behind the sinker above, or the reverse.
+const NECK_HEIGHT_SWITCH_R: f64 = 3.0;
+
+/// The proportions of a chart's loops, in radii before scaling to the stitch size.
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    /// Gap between neighbouring heads.
+    gap_r: f64,
+    /// Height of the neck region.
+    neck_height_r: f64,
+}
+
+impl Shape {
+    /// Room for the switches a chart needs: knit next to purl in a course, or knit above purl
+    /// in a wale.
+    fn of(chart: &[&[Stitch]]) -> Shape {
+        let cyclic_next = |k: usize, n: usize| (k + 1) % n;
+        let along_course =
+            chart.iter().any(|row| (0..row.len()).any(|j| row[j] != row[cyclic_next(j, row.len())]));
+        let along_wale = (0..chart.len()).any(|n| chart[n] != chart[cyclic_next(n, chart.len())]);
+        Shape {
+            gap_r: if along_course { GAP_SWITCH_R } else { GAP_R },
+            neck_height_r: if along_wale { NECK_HEIGHT_SWITCH_R } else { NECK_HEIGHT_R },
+        }
+    }
+
+    fn width_r(&self) -> f64 {
+        NECK_R + 2.0 * BULGE_R + self.gap_r
+    }
+
+    fn height_r(&self) -> f64 {
+        OVERLAP_R + self.neck_height_r
+    }
+}
+
+/// The smallest stitch (width, height) of a chart, in yarn radii: the loop proportions at which
+/// neighbouring yarns keep 1.9 r apart at 32 vertices per stitch.
+pub fn min_stitch_r(chart: &[&[Stitch]]) -> [f64; 2] {
+    let shape = Shape::of(chart);
+    [shape.width_r(), shape.height_r()]
+}
+
 /// B-spline samples per control span (the plan view used to find crossings).
 const SAMPLES_PER_SPAN: usize = 40;
 /// Control points per stitch.
 const CONTROL_PER_STITCH: usize = 10;
+/// Fewest vertices per stitch: two for each of a stitch's eight crossings (four with the
+/// course below, four with the course above).
+pub const MIN_VERTICES_PER_STITCH: usize = 16;
 
 /// Build a knitted tile from its stitch chart: `chart[course][wale]`, course 0 at the bottom.
-pub fn knit(name: &str, chart: &[Vec<Stitch>], p: &GeneratorParams) -> Result<Pattern, GenerateError> {
+pub(crate) fn knit(name: &str, chart: &[&[Stitch]], p: &GeneratorParams) -> Result<Pattern, GenerateError> {
     let r = p.yarn_radius_m;
-    p.require_stitch(MIN_WIDTH_R * r, MIN_HEIGHT_R * r)?;
+    let shape = Shape::of(chart);
+    p.require_stitch(shape.width_r() * r, shape.height_r() * r, MIN_VERTICES_PER_STITCH)?;
     let (courses, wales) = (chart.len(), chart[0].len());
     let period = [wales as f64 * p.stitch_width_m, courses as f64 * p.stitch_height_m];
-    let plan = course_plan(wales, p);
+    let plan = course_plan(wales, shape, p);
     let (arcs, length) = arc_lengths(&plan, [period[0], 0.0]);
     let levels = crossing_levels(chart, &plan, &arcs, length, period[0], p.stitch_height_m);
     let vertices_per_course = p.vertices_per_stitch * wales;
@@ -91,13 +140,13 @@ pub fn knit(name: &str, chart: &[Vec<Stitch>], p: &GeneratorParams) -> Result<Pa
 }
 
 /// Plan view of one course (relative to its base line), sampled along a periodic B-spline.
-fn course_plan(wales: usize, p: &GeneratorParams) -> Vec<[f64; 2]> {
+fn course_plan(wales: usize, shape: Shape, p: &GeneratorParams) -> Vec<[f64; 2]> {
     let (w, h) = (p.stitch_width_m, p.stitch_height_m);
-    let sx = w / SHAPE_WIDTH_R;
-    let sy = h / SHAPE_HEIGHT_R;
+    let sx = w / shape.width_r();
+    let sy = h / shape.height_r();
     let a = NECK_R / 2.0 * sx;
     let c = a + BULGE_R * sx;
-    let m = NECK_HEIGHT_R * sy / 2.0;
+    let m = shape.neck_height_r * sy / 2.0;
     let b = (h + OVERLAP_R * sy) / 2.0;
     let mut control = Vec::with_capacity(wales * CONTROL_PER_STITCH);
     for j in 0..wales {
@@ -144,7 +193,7 @@ impl PlanPoint {
 
 /// For every course, its crossings with the courses above and below: (arc, +1 over / -1 under).
 fn crossing_levels(
-    chart: &[Vec<Stitch>],
+    chart: &[&[Stitch]],
     plan: &[[f64; 2]],
     arcs: &[f64],
     length: f64,

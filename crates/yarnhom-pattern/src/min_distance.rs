@@ -85,43 +85,90 @@ impl YarnNeighbours {
 }
 
 /// The smallest centreline distance between edges of different yarn pieces (see
-/// [`YarnNeighbours`]), over the tile and its 8 neighbouring images. `None` for a pattern with no
-/// such pair.
+/// [`YarnNeighbours`]) over all periodic images: first the tile and its 8 neighbouring images;
+/// then, if the tile is small against the distance found (a segment at a farther image could
+/// still come closer), every image that can, up to [`MAX_IMAGE_REACH`] periods away. A course
+/// whose loops are taller than the tile, for instance, meets the course two tiles up. `None`
+/// for a pattern with no such pair.
 pub fn min_inter_yarn_distance(pattern: &Pattern) -> Option<MinDistance> {
     let neighbours = YarnNeighbours::new(pattern);
-    let segments: Vec<(EdgeRef, u32, Vector3<f64>, Vector3<f64>)> = pattern
+    let segments: Vec<Segment> = pattern
         .edges()
-        .map(|e| {
-            let p0 = Vector3::from(pattern.positions_m[e.from as usize]);
-            let p1 = Vector3::from(pattern.shifted(e.to, e.offset));
-            (EdgeRef { yarn: e.yarn, index: e.index_in_yarn }, e.from, p0, p1)
+        .map(|e| Segment {
+            edge: EdgeRef { yarn: e.yarn, index: e.index_in_yarn },
+            from: e.from,
+            p0: Vector3::from(pattern.positions_m[e.from as usize]),
+            p1: Vector3::from(pattern.shifted(e.to, e.offset)),
         })
         .collect();
+    let nearest = closest_within_images(pattern, &neighbours, &segments, [1, 1])?;
+    let reach = images_within(pattern, &segments, nearest.distance_m);
+    if reach[0] > 1 || reach[1] > 1 {
+        closest_within_images(pattern, &neighbours, &segments, reach)
+    } else {
+        Some(nearest)
+    }
+}
+
+/// An edge with its end points (the end shifted by the edge's tile offset).
+struct Segment {
+    edge: EdgeRef,
+    from: u32,
+    p0: Vector3<f64>,
+    p1: Vector3<f64>,
+}
+
+/// The closest non-neighbouring pair between the tile and its images `-reach..=reach`.
+fn closest_within_images(
+    pattern: &Pattern,
+    neighbours: &YarnNeighbours,
+    segments: &[Segment],
+    reach: [i32; 2],
+) -> Option<MinDistance> {
     let mut best: Option<MinDistance> = None;
-    for ox in -1..=1 {
-        for oy in -1..=1 {
+    for ox in -reach[0]..=reach[0] {
+        for oy in -reach[1]..=reach[1] {
             let shift =
                 Vector3::new(f64::from(ox) * pattern.period_m[0], f64::from(oy) * pattern.period_m[1], 0.0);
-            for (i, (ra, va, a0, a1)) in segments.iter().enumerate() {
-                for (j, (rb, vb, b0, b1)) in segments.iter().enumerate() {
+            for (i, a) in segments.iter().enumerate() {
+                for (j, b) in segments.iter().enumerate() {
                     if ox == 0 && oy == 0 && j <= i {
                         continue; // each unordered pair in the tile once
                     }
-                    let (b0, b1) = (b0 + shift, b1 + shift);
+                    let (b0, b1) = (b.p0 + shift, b.p1 + shift);
                     let bound = best.map_or(f64::INFINITY, |m| m.distance_m);
-                    if lower_bound(a0, a1, &b0, &b1) >= bound || neighbours.are_neighbours(*va, *vb, [ox, oy])
+                    if lower_bound(&a.p0, &a.p1, &b0, &b1) >= bound
+                        || neighbours.are_neighbours(a.from, b.from, [ox, oy])
                     {
                         continue;
                     }
-                    let d = segment_distance(a0, a1, &b0, &b1).distance;
+                    let d = segment_distance(&a.p0, &a.p1, &b0, &b1).distance;
                     if d < bound {
-                        best = Some(MinDistance { distance_m: d, a: *ra, b: *rb, image: [ox, oy] });
+                        best = Some(MinDistance { distance_m: d, a: a.edge, b: b.edge, image: [ox, oy] });
                     }
                 }
             }
         }
     }
     best
+}
+
+/// Farthest image searched along an axis. Tiles whose vertices lie within a few periods of the
+/// tile (every generated or published one) never need it; it bounds the work for patterns with
+/// vertices spread over many periods, whose farther images are then not searched.
+pub const MAX_IMAGE_REACH: i32 = 8;
+
+/// How many images along each axis can hold a segment closer than `distance` to the tile's: the
+/// segments span a box of extent `e` along an axis, so an image `k` periods away is at least
+/// `k * period - e` from them. Between 1 and [`MAX_IMAGE_REACH`].
+fn images_within(pattern: &Pattern, segments: &[Segment], distance: f64) -> [i32; 2] {
+    std::array::from_fn(|axis| {
+        let ends = segments.iter().flat_map(|s| [s.p0[axis], s.p1[axis]]);
+        let (lo, hi) = ends.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)));
+        let images = ((hi - lo + distance) / pattern.period_m[axis]).floor();
+        // A non-finite extent (invalid positions) stays with the neighbouring images.
+        if images.is_finite() { (images.min(f64::from(MAX_IMAGE_REACH)) as i32).max(1) } else { 1 }
+    })
 }
 
 /// A cheap lower bound of the distance between two segments: midpoint distance minus half
@@ -139,4 +186,52 @@ fn multiple_of(closure: [i32; 2], offset: [i32; 2]) -> Option<i32> {
         [c, _] => offset[0] / c,
     };
     (m * closure[0] == offset[0] && m * closure[1] == offset[1]).then_some(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use yarnhom_artifacts::{Fabric, Yarn};
+
+    /// Two straight yarns along X1 in a unit tile, at X2 = `y[0]` and `y[1]`; radius 0.2, so a
+    /// yarn's own pieces (1/3 apart) are within `pi r` of each other along it.
+    fn two_straight_yarns(y: [f64; 2]) -> Pattern {
+        let xs = [0.0, 1.0 / 3.0, 2.0 / 3.0];
+        let positions_m = y.iter().flat_map(|&y| xs.map(|x| [x, y, 0.0])).collect();
+        let yarn = |first: u32| Yarn {
+            radius_m: 0.2,
+            vertices: (first..first + 3).collect(),
+            edge_offsets: vec![[0, 0], [0, 0], [1, 0]],
+        };
+        Pattern {
+            name: "lines".into(),
+            fabric: Fabric::Woven,
+            period_m: [1.0, 1.0],
+            positions_m,
+            edge_twist_rad: vec![0.0; 6],
+            yarns: vec![yarn(0), yarn(3)],
+            rest: None,
+            origin: "test".into(),
+        }
+    }
+
+    #[test]
+    fn a_yarn_stored_periods_away_is_measured_against_its_nearest_image() {
+        // Yarn 1 lies 0.45 above yarn 0 once moved back two periods; the neighbouring images
+        // alone would report yarn 0 against its own image one period up (1.0 apart).
+        let p = two_straight_yarns([0.0, 2.45]);
+        p.validate().expect("valid");
+        let m = min_inter_yarn_distance(&p).expect("pairs");
+        assert!((m.distance_m - 0.45).abs() < 1e-12, "{m:?}");
+        assert_eq!(m.image[1].abs(), 2, "{m:?}");
+    }
+
+    #[test]
+    fn a_straight_yarn_is_not_its_own_neighbour_along_itself() {
+        // Same yarn, images shifted along its closure: one physical yarn, no pair counts; the
+        // closest pieces are the yarns 0.3 apart.
+        let m = min_inter_yarn_distance(&two_straight_yarns([0.0, 0.3])).expect("pairs");
+        assert!((m.distance_m - 0.3).abs() < 1e-12, "{m:?}");
+        assert_ne!(m.a.yarn, m.b.yarn);
+    }
 }

@@ -1,25 +1,34 @@
 //! Woven tiles: weft yarns run along X1, warp yarns along X2, and at every crossing one passes
 //! over the other as the weave's interlacing chart says. Yarns are straight in plan view; their
-//! height follows [`undulate`] through the crossings, so crossing centrelines are `2 * 1.05 r`
-//! apart and level where they meet.
+//! height follows `curve::undulate` through the crossings, so crossing centrelines are
+//! `2 * LEVEL_R = 3 r` apart and level where they meet.
 
 use yarnhom_artifacts::{Fabric, Pattern};
 
 use crate::curve::{LEVEL_R, PLATEAU, resample, undulate};
 use crate::{GenerateError, GeneratorParams, add_yarn};
 
-/// Smallest spacing of parallel yarns, in radii: below it the yarns' slopes between crossings
-/// bring crossing yarns closer than 1.9 radii (3.0 r gives 1.83 r, 3.5 r gives 2.03 r).
-pub const MIN_SPACING_R: f64 = 3.4;
+/// Smallest spacing of parallel yarns, in radii. Two limits meet here: where a weft and a warp
+/// both change sides next to the same crossing, their mid-points (both at mid-plane height) are
+/// `spacing / sqrt(2)` apart in plan; and a yarn passing under one crossing yarn and over the
+/// next must climb `2 * LEVEL_R` between them. At 2.9 r all three weaves keep 1.9 r (2.9 r gives
+/// 1.91-1.94 r, 3.0 r gives 1.97-1.99 r; the published jammed tiles are 2.2-2.7 r).
+pub const MIN_SPACING_R: f64 = 2.9;
+/// Fewest vertices per yarn spacing: a crossing's level stretch and the climb to the next.
+pub const MIN_VERTICES_PER_SPACING: usize = 4;
 /// Plan-view samples per yarn spacing before resampling to equal arc length.
 const SAMPLES_PER_SPACING: usize = 64;
 
 /// Build a woven tile from its interlacing chart: `warp_over[weft][warp]` is true where the warp
 /// passes over the weft. Weft `j` lies at X2 = `(j + 1/2) * stitch_height_m`, warp `i` at
 /// X1 = `(i + 1/2) * stitch_width_m`.
-pub fn weave(name: &str, warp_over: &[Vec<bool>], p: &GeneratorParams) -> Result<Pattern, GenerateError> {
+pub(crate) fn weave(
+    name: &str,
+    warp_over: &[&[bool]],
+    p: &GeneratorParams,
+) -> Result<Pattern, GenerateError> {
     let r = p.yarn_radius_m;
-    p.require_stitch(MIN_SPACING_R * r, MIN_SPACING_R * r)?;
+    p.require_stitch(MIN_SPACING_R * r, MIN_SPACING_R * r, MIN_VERTICES_PER_SPACING)?;
     let (wefts, warps) = (warp_over.len(), warp_over[0].len());
     let period = [warps as f64 * p.stitch_width_m, wefts as f64 * p.stitch_height_m];
     let centre = |k: usize, spacing: f64, period: f64| (k as f64 + 0.5) * spacing - period / 2.0;

@@ -85,13 +85,14 @@ fn edge_lengths(p: &Pattern) -> Vec<f64> {
 
 #[test]
 fn edges_are_near_uniform_and_shorter_than_the_radius_scale() {
-    // Knit curves are resampled at equal arc length; woven yarns at equal steps in plan, so
-    // their edges differ only through the slope of the undulation.
+    // Every yarn is resampled at equal arc length, so edges differ only where a chord cuts a
+    // bend: a chord across an arc of angle 2x is sin(x)/x of the arc, and 1.2 allows bends down
+    // to a radius of half an edge (x = 1); generated yarns bend no tighter than about a radius.
     for g in GENERATORS {
         let p = make(g.name, |_| {});
         let l = edge_lengths(&p);
         let (lo, hi) = l.iter().fold((f64::INFINITY, 0.0f64), |(a, b), &x| (a.min(x), b.max(x)));
-        assert!(hi / lo < 1.5, "{}: edge lengths {lo:.2e}..{hi:.2e}", g.name);
+        assert!(hi / lo < 1.2, "{}: edge lengths {lo:.2e}..{hi:.2e}", g.name);
         assert!(
             hi < 2.0 * p.yarns[0].radius_m,
             "{}: edges of {hi:.2e} m are coarse against the radius",
@@ -215,29 +216,49 @@ fn a_purl_wale_is_a_knit_wale_mirrored() {
 
 #[test]
 fn the_smallest_allowed_stitches_still_do_not_interpenetrate() {
-    for name in KNITS {
-        let p = make(name, |p| {
-            p.stitch_width_m = yarnhom_pattern::knit::MIN_WIDTH_R * p.yarn_radius_m;
-            p.stitch_height_m = yarnhom_pattern::knit::MIN_HEIGHT_R * p.yarn_radius_m;
-        });
+    for g in GENERATORS {
+        let p = make(g.name, |p| [p.stitch_width_m, p.stitch_height_m] = g.min_stitch_m(p.yarn_radius_m));
+        let r = p.yarns[0].radius_m;
         let m = min_inter_yarn_distance(&p).expect("pairs");
-        assert!(
-            m.distance_m >= 1.9 * p.yarns[0].radius_m,
-            "{name}: {:.3} r",
-            m.distance_m / p.yarns[0].radius_m
-        );
+        assert!(m.distance_m >= 1.9 * r, "{}: {:.3} r", g.name, m.distance_m / r);
+        // And anything smaller is refused up front.
+        let mut smaller = GeneratorParams::defaults_for(g.name).expect("known");
+        smaller.stitch_width_m = 0.99 * g.min_stitch_m(smaller.yarn_radius_m)[0];
+        assert!(matches!(generate(g.name, &smaller), Err(GenerateError::BadParameter(_))), "{}", g.name);
     }
-    for name in WEAVES {
-        let p = make(name, |p| {
-            p.stitch_width_m = yarnhom_pattern::weave::MIN_SPACING_R * p.yarn_radius_m;
-            p.stitch_height_m = p.stitch_width_m;
-        });
-        let m = min_inter_yarn_distance(&p).expect("pairs");
-        assert!(
-            m.distance_m >= 1.9 * p.yarns[0].radius_m,
-            "{name}: {:.3} r",
-            m.distance_m / p.yarns[0].radius_m
-        );
+}
+
+#[test]
+fn too_coarse_a_tessellation_is_refused_not_returned() {
+    // Garter at its smallest stitch with the fewest vertices allowed: the chords cut the loops'
+    // corners and bring yarns within 1.9 r, which the generator reports instead of returning.
+    let mut p = GeneratorParams::defaults_for("garter").expect("garter");
+    [p.stitch_width_m, p.stitch_height_m] = GENERATORS[1].min_stitch_m(p.yarn_radius_m);
+    p.vertices_per_stitch = yarnhom_pattern::knit::MIN_VERTICES_PER_STITCH;
+    match generate("garter", &p) {
+        Err(GenerateError::TooClose { distance_r, .. }) => assert!(distance_r < 1.9),
+        other => panic!("expected TooClose, got {other:?}"),
+    }
+}
+
+#[test]
+fn default_knit_stitches_are_in_proportion_to_the_published_stockinette() {
+    // The published tile holds two courses (its two yarns) of two loops each.
+    let Some(stock) = published("stock") else { return };
+    let loops_per_course = {
+        let y: Vec<f64> = stock.yarns[0].vertices.iter().map(|&v| stock.positions_m[v as usize][1]).collect();
+        let n = y.len();
+        // A loop's head is a local maximum of X2 along the course, well above the course's middle.
+        let mid = (y.iter().cloned().fold(f64::INFINITY, f64::min)
+            + y.iter().cloned().fold(f64::NEG_INFINITY, f64::max))
+            / 2.0;
+        (0..n).filter(|&k| y[k] > mid && y[k] >= y[(k + n - 1) % n] && y[k] > y[(k + 1) % n]).count()
+    };
+    assert_eq!(loops_per_course, 2);
+    let published = [stock.period_m[0] / 2.0, stock.period_m[1] / stock.yarns.len() as f64];
+    let d = GeneratorParams::defaults_for("stockinette").expect("stockinette");
+    for (ours, theirs) in [d.stitch_width_m, d.stitch_height_m].into_iter().zip(published) {
+        assert!((1.0..1.2).contains(&(ours / theirs)), "default {ours} m against published {theirs} m");
     }
 }
 
@@ -250,6 +271,8 @@ fn bad_parameters_are_errors_not_panics() {
         GeneratorParams { stitch_height_m: 0.0, ..d },
         GeneratorParams { stitch_width_m: 5e-3, ..d },
         GeneratorParams { vertices_per_stitch: 2, ..d },
+        GeneratorParams { vertices_per_stitch: usize::MAX, ..d },
+        GeneratorParams { yarn_radius_m: f64::INFINITY, ..d },
     ];
     for c in cases {
         assert!(matches!(generate("rib", &c), Err(GenerateError::BadParameter(_))), "{c}");
@@ -284,5 +307,37 @@ fn published_relaxed_patterns_have_touching_yarns() {
         let m = min_inter_yarn_distance(&p).expect("pairs");
         let ratio = m.distance_m / r;
         assert!((1.0..2.5).contains(&ratio), "{name}: closest centrelines {ratio:.3} radii apart");
+    }
+}
+
+mod accepted_region {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+        /// Stitches from the generator's minimum up to 2.5 times it along each axis, at the
+        /// default resolution or finer, are always accepted (so never closer than 1.9 r).
+        #[test]
+        fn stitches_between_the_minimum_and_two_and_a_half_times_it_are_accepted(
+            g in 0..GENERATORS.len(),
+            fw in 1.0f64..2.5,
+            fh in 1.0f64..2.5,
+            finer in 1usize..3,
+            r in 1e-4f64..1e-2,
+        ) {
+            let g = &GENERATORS[g];
+            let d = GeneratorParams::defaults_for(g.name).expect("known");
+            let [w, h] = g.min_stitch_m(r);
+            let p = GeneratorParams {
+                stitch_width_m: fw * w,
+                stitch_height_m: fh * h,
+                yarn_radius_m: r,
+                vertices_per_stitch: finer * d.vertices_per_stitch,
+            };
+            let pattern = generate(g.name, &p).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let m = min_inter_yarn_distance(&pattern).expect("pairs");
+            prop_assert!(m.distance_m >= 1.9 * r);
+        }
     }
 }
