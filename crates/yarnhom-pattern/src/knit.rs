@@ -29,7 +29,7 @@ use yarnhom_artifacts::{Fabric, Pattern};
 use yarnhom_geom::segment_crossing_2d;
 
 use crate::curve::{LEVEL_R, PLATEAU, arc_lengths, periodic_bspline, resample, undulate};
-use crate::{GenerateError, GeneratorParams, add_yarn};
+use crate::{GenerateError, GeneratorParams, add_yarn, generated};
 
 /// Knit or purl, as seen from the front (+X3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -127,16 +127,7 @@ pub(crate) fn knit(name: &str, chart: &[&[Stitch]], p: &GeneratorParams) -> Resu
         let points = resample(&curve, [period[0], 0.0, 0.0], vertices_per_course);
         yarns.push(add_yarn(&mut positions, points.into_iter(), [1, 0], r));
     }
-    Ok(Pattern {
-        name: name.into(),
-        fabric: Fabric::Knit,
-        period_m: period,
-        edge_twist_rad: vec![0.0; positions.len()],
-        positions_m: positions,
-        yarns,
-        rest: None,
-        origin: format!("generator {name} {p}"),
-    })
+    Ok(generated(name, Fabric::Knit, period, positions, yarns, p))
 }
 
 /// Plan view of one course (relative to its base line), sampled along a periodic B-spline.

@@ -276,6 +276,27 @@ pub fn generate(name: &str, params: &GeneratorParams) -> Result<Pattern, Generat
     info(name)?.generate(params)
 }
 
+/// A generated pattern: untwisted, without rest state, its origin naming generator and parameters.
+fn generated(
+    name: &str,
+    fabric: Fabric,
+    period_m: [f64; 2],
+    positions_m: Vec<[f64; 3]>,
+    yarns: Vec<Yarn>,
+    params: &GeneratorParams,
+) -> Pattern {
+    Pattern {
+        name: name.into(),
+        fabric,
+        period_m,
+        edge_twist_rad: vec![0.0; positions_m.len()],
+        positions_m,
+        yarns,
+        rest: None,
+        origin: format!("generator {name} {params}"),
+    }
+}
+
 /// Append a yarn through `points` (closing with tile offset `closure`) to `positions`.
 fn add_yarn(
     positions: &mut Vec<[f64; 3]>,

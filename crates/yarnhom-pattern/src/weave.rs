@@ -6,7 +6,7 @@
 use yarnhom_artifacts::{Fabric, Pattern};
 
 use crate::curve::{LEVEL_R, PLATEAU, resample, undulate};
-use crate::{GenerateError, GeneratorParams, add_yarn};
+use crate::{GenerateError, GeneratorParams, add_yarn, generated};
 
 /// Smallest spacing of parallel yarns, in radii. Two limits meet here: where a weft and a warp
 /// both change sides next to the same crossing, their mid-points (both at mid-plane height) are
@@ -64,16 +64,7 @@ pub(crate) fn weave(
             r,
         ));
     }
-    Ok(Pattern {
-        name: name.into(),
-        fabric: Fabric::Woven,
-        period_m: period,
-        edge_twist_rad: vec![0.0; positions.len()],
-        positions_m: positions,
-        yarns,
-        rest: None,
-        origin: format!("generator {name} {p}"),
-    })
+    Ok(generated(name, Fabric::Woven, period, positions, yarns, p))
 }
 
 /// `(position along the yarn, height)` at `n` points equally spaced in arc length along a
