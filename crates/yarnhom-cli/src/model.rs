@@ -20,7 +20,7 @@ pub enum ModelCommand {
 pub struct WriteArgs {
     /// Model name, e.g. `table4.1:stock` (see `model list`).
     pub name: String,
-    /// Output file (default: <row>.yarnmodel.yh).
+    /// Output file (default: ROW.yarnmodel.yh).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
 }

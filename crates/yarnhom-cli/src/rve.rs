@@ -41,7 +41,7 @@ pub struct SolveArgs {
     /// Newton iteration limit.
     #[arg(long, default_value_t = 2000)]
     pub max_iterations: usize,
-    /// Output file (default: <pattern>.rvesolve.yh).
+    /// Output file (default: PATTERN.rvesolve.yh, PATTERN the input's base name).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
 }

@@ -12,7 +12,7 @@ pub struct SchemaArgs {
     /// Artifact kind (pattern, yarnmodel). Omit with --write-all.
     #[arg(required_unless_present = "write_all")]
     pub kind: Option<String>,
-    /// Write the current schema of every kind as DIR/<kind>.v<N>.schema.json (how the
+    /// Write the current schema of every kind as DIR/KIND.vN.schema.json (how the
     /// committed `schemas/` folder is made).
     #[arg(long, value_name = "DIR", conflicts_with = "kind")]
     pub write_all: Option<PathBuf>,

@@ -10,7 +10,7 @@
 //! - [`model`]: the tile's elements and rest state, built from a pattern and a yarn model;
 //! - [`placement`]: where vertex instances go under a macro strain;
 //! - [`assembly`]: energy, gradient and Hessian over `g`;
-//! - [`solve`]: the constrained Newton solve for the tile's equilibrium;
+//! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
 //! - [`homogenize`]: energy density and stress at a macro strain.
 
