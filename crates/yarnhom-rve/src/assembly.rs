@@ -289,8 +289,11 @@ fn add_contacts(
         .collect();
     let tile_index = model.images.iter().position(|&o| o == [0, 0]).expect("the tile itself is an image");
     let tile = &ends[tile_index];
+    // Images whose edges all lie beyond reach of the tile's bounding box hold no contact.
+    let bounds: Vec<(Vector3<f64>, Vector3<f64>)> = ends.iter().map(|e| bounding_box(e)).collect();
+    let near: Vec<bool> = bounds.iter().map(|b| box_gap(b, &bounds[tile_index]) < reach).collect();
     for (a, sa) in model.stretch.iter().enumerate() {
-        for (image_index, &o) in model.images.iter().enumerate() {
+        for (image_index, &o) in model.images.iter().enumerate().filter(|(i, _)| near[*i]) {
             for (b, sb) in model.stretch.iter().enumerate() {
                 // Each physical pair once: (a, b, o) and (b, a, -o) are the same pair.
                 if !(a < b || (a == b && o > [0, 0])) {
@@ -339,4 +342,19 @@ pub fn world_positions(model: &RveModel, placement: &Placement, state: &RveState
     (0..model.vertices as u32)
         .map(|v| position_of(model, placement, &state.g, Instance { vertex: v, image: [0, 0] }).into())
         .collect()
+}
+
+/// Axis-aligned bounding box of some segments.
+fn bounding_box(segments: &[(Vector3<f64>, Vector3<f64>)]) -> (Vector3<f64>, Vector3<f64>) {
+    segments
+        .iter()
+        .fold((Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)), |(lo, hi), (p, q)| {
+            (lo.inf(p).inf(q), hi.sup(p).sup(q))
+        })
+}
+
+/// Distance between two axis-aligned boxes (0 when they overlap).
+fn box_gap(a: &(Vector3<f64>, Vector3<f64>), b: &(Vector3<f64>, Vector3<f64>)) -> f64 {
+    let gap = (a.0 - b.1).sup(&(b.0 - a.1)).sup(&Vector3::zeros());
+    gap.norm()
 }
