@@ -8,6 +8,7 @@
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
 
+pub mod arcsim;
 pub mod check;
 pub mod container;
 pub mod diff;

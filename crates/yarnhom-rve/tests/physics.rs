@@ -2,6 +2,7 @@
 //! Heavy (rib alone takes about 16 s per solve): run with
 //! `cargo test --release -p yarnhom-rve --test physics -- --ignored`.
 
+use yarnhom_artifacts::arcsim::HylcFit;
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::solve_at;
@@ -40,34 +41,11 @@ fn honeycomb_contracts_sideways_when_stretched() {
     assert!(minus < zero && zero < plus, "honey at sx=0.3: sy=-0.05 {minus}, 0 {zero}, +0.05 {plus}");
 }
 
-/// The published HYLC fit's 1D term `k` (0 = sx) at strain `x`: a cubic Hermite spline over
-/// `strain / strain scale`, extrapolated linearly (../shared/data/hylc-materials/FORMAT.md).
+/// The published HYLC fit's 1D term `k` (0 = sx) at strain `x`.
 fn published_term(name: &str, k: usize, x: f64) -> f64 {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}1.json", env!("CARGO_MANIFEST_DIR"));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).expect("fit")).expect("json");
-    let scale = json["strain scale"][k].as_f64().expect("scale");
-    let term = json["coeffs"]["1D"].as_array().expect("1D terms").iter().find(|t| t["k"] == k).expect("term");
-    let v = |key: &str| -> Vec<f64> {
-        term[key].as_array().expect(key).iter().map(|x| x.as_f64().expect("number")).collect()
-    };
-    let (t, p, m) = (v("t"), v("p"), v("m"));
-    let u = x / scale;
-    let last = t.len() - 1;
-    if u <= t[0] {
-        return p[0] + m[0] * (u - t[0]);
-    }
-    if u >= t[last] {
-        return p[last] + m[last] * (u - t[last]);
-    }
-    let i = t.iter().position(|&ti| ti > u).expect("inside") - 1;
-    let h = t[i + 1] - t[i];
-    let s = (u - t[i]) / h;
-    let (s2, s3) = (s * s, s * s * s);
-    (2.0 * s3 - 3.0 * s2 + 1.0) * p[i]
-        + (s3 - 2.0 * s2 + s) * h * m[i]
-        + (-2.0 * s3 + 3.0 * s2) * p[i + 1]
-        + (s3 - s2) * h * m[i + 1]
+    let fit = HylcFit::parse(&std::fs::read_to_string(&path).expect("fit")).expect("published fit parses");
+    fit.term_1d(k, x).expect("the fit has the term")
 }
 
 #[test]
