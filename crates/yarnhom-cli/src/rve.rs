@@ -8,7 +8,8 @@ use clap::{Args, Subcommand};
 use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, container};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::{solve_at, stress_by_finite_differences};
-use yarnhom_rve::{RveModel, SolveOptions, StopReason};
+use yarnhom_rve::relax::RelaxEvent;
+use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, StopReason};
 
 use crate::Outcome;
 use crate::inputs::{self, base_name, provenance};
@@ -22,6 +23,38 @@ pub enum RveCommand {
     /// when the solve converged, 1 when it did not (the artifact is written anyway and says so,
     /// with no energy), 2 on bad input.
     Solve(SolveArgs),
+    /// Compute a pattern's rest state: Algorithm 2 of the thesis (stress-free state, pre-tension,
+    /// in-plane energy minimum), or the rest-shape estimation of Sec. 6.5.2 (`--estimation`).
+    ///
+    /// The result is a pattern whose tile carries no in-plane stress at zero strain (Algorithm 2)
+    /// or whose rest lengths stay within the given bound of the input (Sec. 6.5.2). Works on
+    /// generated patterns (no rest state yet) and on imported ones. Exit status 0 on success,
+    /// 2 when a stage fails (the message names the stage).
+    Relax(RelaxArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct RelaxArgs {
+    /// The pattern (`.yh`, JSON, HDF5 or `.pyp`).
+    pub pattern: PathBuf,
+    /// Yarn model: a built-in `table4.1:<row>` (see `yarnhom model list`) or a `yarnmodel` file.
+    #[arg(long)]
+    pub model: String,
+    /// Sec. 6.5.2 instead of Algorithm 2: rest-shape resets with rest lengths bounded to the
+    /// given relative change of their input values (the thesis uses 0.2), no pre-tension and
+    /// no period change.
+    #[arg(long, value_name = "MAX_LENGTH_CHANGE")]
+    pub estimation: Option<f64>,
+    /// Keep the input's rest shape and only move the periods to the in-plane energy minimum
+    /// (Algorithm 2's last stage), e.g. for published patterns relaxed by another code.
+    #[arg(long, conflicts_with = "estimation")]
+    pub keep_rest_shape: bool,
+    /// Largest number of rest-shape resets.
+    #[arg(long, default_value_t = 40)]
+    pub max_resets: usize,
+    /// Output file (default: PATTERN.relaxed.pattern.yh, PATTERN the input's base name).
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -49,6 +82,7 @@ pub struct SolveArgs {
 pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
     match cmd {
         RveCommand::Solve(args) => solve(args),
+        RveCommand::Relax(args) => relax(args),
     }
 }
 
@@ -137,4 +171,78 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         eprintln!("error: the solve did not converge ({})", stop_reason(report.reason));
         Ok(Outcome::Different)
     }
+}
+
+fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
+    let loaded = inputs::load(&args.pattern, None)?;
+    let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
+        anyhow::bail!("{}: holds a '{}', not a pattern", args.pattern.display(), loaded.artifact.kind())
+    };
+    let (model, model_input) = load_model(&args.model)?;
+    let method = match args.estimation {
+        Some(bound) if !(bound > 0.0 && bound < 1.0) => {
+            anyhow::bail!("--estimation {bound}: the rest-length bound must lie strictly between 0 and 1")
+        }
+        Some(max_length_change) => RelaxMethod::Estimation { max_length_change },
+        None => RelaxMethod::Reference,
+    };
+    if args.keep_rest_shape && pattern.rest.is_none() {
+        anyhow::bail!(
+            "{}: --keep-rest-shape needs a pattern with a rest state, and '{}' has none",
+            args.pattern.display(),
+            pattern.name
+        );
+    }
+    let options = RelaxOptions {
+        method,
+        keep_rest_shape: args.keep_rest_shape,
+        max_resets: args.max_resets,
+        ..RelaxOptions::default()
+    };
+    eprintln!("relaxing '{}' ({} vertices) with '{}'", pattern.name, pattern.vertex_count(), model.name);
+    let started = Instant::now();
+    let mut show = |event: RelaxEvent| match event {
+        RelaxEvent::Reset(k, energy) => {
+            eprintln!("  reset {:>3}: relaxed tile energy {energy:.3e} J ({:.1} s)", k + 1, started.elapsed().as_secs_f64())
+        }
+        RelaxEvent::PeriodStep(s, sigma) => eprintln!(
+            "  periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m² ({:.1} s)",
+            s[0],
+            s[1],
+            sigma[0],
+            sigma[1],
+            started.elapsed().as_secs_f64()
+        ),
+    };
+    let (relaxed, report) = yarnhom_rve::relax(pattern, &model, &options, &mut show)
+        .with_context(|| format!("{}", args.pattern.display()))?;
+    if !args.keep_rest_shape && report.stress_free_energy_j >= options.stress_free_energy_j {
+        eprintln!(
+            "warning: no stress-free state within {} resets (tile energy {:.3e} J, target {:.0e} J); continuing",
+            report.resets, report.stress_free_energy_j, options.stress_free_energy_j
+        );
+    }
+    let output =
+        args.output.unwrap_or_else(|| format!("{}.relaxed.pattern.yh", base_name(&args.pattern)).into());
+    let mut inputs_list = vec![yarnhom_artifacts::InputRef {
+        kind: "pattern".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: args.pattern.display().to_string(),
+    }];
+    inputs_list.extend(model_input);
+    container::write(&output, &relaxed, &provenance("rve relax", inputs_list))?;
+    let [sx, sa, sy] = report.residual_stress_j_m2;
+    println!(
+        "relaxed '{}': {} resets, periods {:.4} x {:.4} mm (period strain {:+.4}, {:+.4}), {} Newton iterations, {:.1} s\n  in-plane stress at zero strain: dsx {sx:.3e}, dsa {sa:.3e}, dsy {sy:.3e} J/m²",
+        relaxed.name,
+        report.resets,
+        relaxed.period_m[0] * 1e3,
+        relaxed.period_m[1] * 1e3,
+        report.period_strain[0],
+        report.period_strain[1],
+        report.iterations,
+        started.elapsed().as_secs_f64()
+    );
+    eprintln!("wrote {}", output.display());
+    Ok(Outcome::Success)
 }

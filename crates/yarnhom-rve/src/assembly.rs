@@ -26,8 +26,8 @@ pub struct Assembled {
 /// What to assemble.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Want {
-    /// Energy only (line searches).
-    Energy,
+    /// Energy and gradient (line searches, stress).
+    EnergyGradient,
     /// Energy, gradient and Hessian.
     Derivatives,
 }
@@ -256,8 +256,11 @@ pub fn assemble(
     out
 }
 
-/// Contact between every edge of the tile and every edge of the tile images within reach
-/// ([`RveModel::images`]), each physical pair once, neighbours along a yarn excluded.
+/// Contact (Sec. 3.3) between every edge of the tile and every edge of the tile images within
+/// reach ([`RveModel::images`]), each physical pair once, neighbours along a yarn excluded. The
+/// candidates come from the broad phase ([`crate::broadphase`]) on the edges' boxes grown by half
+/// the reach, which overlap for every pair within reach (the contact energy vanishes beyond it);
+/// they are summed in sorted order, so the result is reproducible.
 fn add_contacts(
     model: &RveModel,
     placement: &Placement,
@@ -265,63 +268,55 @@ fn add_contacts(
     derivatives: bool,
     out: &mut Assembled,
 ) {
+    use crate::broadphase::{Aabb, EdgePair};
     let reach = model.contact.reach_m();
-    let shifted = |i: Instance, o: [i32; 2]| Instance {
-        vertex: i.vertex,
-        image: [i.image[0] + o[0], i.image[1] + o[1]],
-    };
-    // Endpoints of every edge in every image.
-    let ends: Vec<Vec<(Vector3<f64>, Vector3<f64>)>> = model
+    let ends = image_segments(model, placement, g);
+    // The relative 1e-9 keeps pairs whose quadrature points round to just within reach.
+    let margin = 0.5 * reach * (1.0 + 1e-9);
+    let boxes: Vec<Vec<Aabb>> =
+        ends.iter().map(|e| e.iter().map(|(p, q)| Aabb::around_segment(p, q, margin)).collect()).collect();
+    let tile = &ends[crate::broadphase::tile_image(model)];
+    for EdgePair { a, image, b } in crate::broadphase::edge_pairs(model, &boxes) {
+        let (a0, a1) = tile[a];
+        let (b0, b1) = ends[image][b];
+        if lower_bound(&a0, &a1, &b0, &b1) >= reach {
+            continue;
+        }
+        let (e, grad, hess) = contact_energy(
+            &model.contact,
+            [&a0, &a1, &b0, &b1],
+            model.rest_length_m[a],
+            model.rest_length_m[b],
+        );
+        if e == 0.0 && grad.amax() == 0.0 {
+            continue;
+        }
+        out.energy_j += e;
+        let h = derivatives.then_some(hess.as_slice());
+        let (sa, sb, o) = (model.stretch[a], model.stretch[b], model.images[image]);
+        let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
+        Scatter { model, placement, out: &mut *out }.add(&instances, &[], grad.as_slice(), h);
+    }
+}
+
+/// The instance `i` moved by the tile offset `o`.
+fn shifted(i: Instance, o: [i32; 2]) -> Instance {
+    Instance { vertex: i.vertex, image: [i.image[0] + o[0], i.image[1] + o[1]] }
+}
+
+/// Endpoints of every edge in every contact image ([`RveModel::images`]) at DOFs `g`, as
+/// `[image][edge]`.
+pub(crate) fn image_segments(
+    model: &RveModel,
+    placement: &Placement,
+    g: &DVector<f64>,
+) -> Vec<Vec<(Vector3<f64>, Vector3<f64>)>> {
+    let position = |i: Instance, o: [i32; 2]| position_of(model, placement, g, shifted(i, o));
+    model
         .images
         .iter()
-        .map(|&o| {
-            model
-                .stretch
-                .iter()
-                .map(|s| {
-                    (
-                        position_of(model, placement, g, shifted(s.from, o)),
-                        position_of(model, placement, g, shifted(s.to, o)),
-                    )
-                })
-                .collect()
-        })
-        .collect();
-    let tile_index = model.images.iter().position(|&o| o == [0, 0]).expect("the tile itself is an image");
-    let tile = &ends[tile_index];
-    // Images whose edges all lie beyond reach of the tile's bounding box hold no contact.
-    let bounds: Vec<(Vector3<f64>, Vector3<f64>)> = ends.iter().map(|e| bounding_box(e)).collect();
-    let near: Vec<bool> = bounds.iter().map(|b| box_gap(b, &bounds[tile_index]) < reach).collect();
-    for (a, sa) in model.stretch.iter().enumerate() {
-        for (image_index, &o) in model.images.iter().enumerate().filter(|(i, _)| near[*i]) {
-            for (b, sb) in model.stretch.iter().enumerate() {
-                // Each physical pair once: (a, b, o) and (b, a, -o) are the same pair.
-                if !(a < b || (a == b && o > [0, 0])) {
-                    continue;
-                }
-                let (a0, a1) = tile[a];
-                let (b0, b1) = ends[image_index][b];
-                if lower_bound(&a0, &a1, &b0, &b1) >= reach
-                    || model.neighbours.are_neighbours(sa.from.vertex, sb.from.vertex, o)
-                {
-                    continue;
-                }
-                let (e, grad, hess) = contact_energy(
-                    &model.contact,
-                    [&a0, &a1, &b0, &b1],
-                    model.rest_length_m[a],
-                    model.rest_length_m[b],
-                );
-                if e == 0.0 && grad.amax() == 0.0 {
-                    continue;
-                }
-                out.energy_j += e;
-                let h = derivatives.then_some(hess.as_slice());
-                let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
-                Scatter { model, placement, out: &mut *out }.add(&instances, &[], grad.as_slice(), h);
-            }
-        }
-    }
+        .map(|&o| model.stretch.iter().map(|s| (position(s.from, o), position(s.to, o))).collect())
+        .collect()
 }
 
 /// Energy of every bend-twist element (J), in vertex order: where a tile stores bending.
@@ -337,24 +332,28 @@ pub fn bend_energies(model: &RveModel, placement: &Placement, state: &RveState) 
         .collect()
 }
 
+/// Material curvature `(κ1, κ2)` and twist `m` (rad) of every bend-twist element, in vertex
+/// order: the values a rest-shape reset stores (Alg. 2, Sec. 6.5.2).
+pub fn bend_strains(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<([f64; 2], f64)> {
+    model
+        .bends
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let q = bend_dofs(model, placement, &state.g, b);
+            curvature_and_twist(&bend_reference(placement, state, b, k), &std::array::from_fn(|i| q[i]))
+        })
+        .collect()
+}
+
+/// Length of every edge (m), by source vertex, at the state's DOFs.
+pub fn edge_lengths(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<f64> {
+    model.stretch.iter().map(|s| world_edge(model, placement, &state.g, s.from, s.to).norm()).collect()
+}
+
 /// World positions of the tile's vertices at the state's DOFs.
 pub fn world_positions(model: &RveModel, placement: &Placement, state: &RveState) -> Vec<[f64; 3]> {
     (0..model.vertices as u32)
         .map(|v| position_of(model, placement, &state.g, Instance { vertex: v, image: [0, 0] }).into())
         .collect()
-}
-
-/// Axis-aligned bounding box of some segments.
-fn bounding_box(segments: &[(Vector3<f64>, Vector3<f64>)]) -> (Vector3<f64>, Vector3<f64>) {
-    segments
-        .iter()
-        .fold((Vector3::repeat(f64::INFINITY), Vector3::repeat(f64::NEG_INFINITY)), |(lo, hi), (p, q)| {
-            (lo.inf(p).inf(q), hi.sup(p).sup(q))
-        })
-}
-
-/// Distance between two axis-aligned boxes (0 when they overlap).
-fn box_gap(a: &(Vector3<f64>, Vector3<f64>), b: &(Vector3<f64>, Vector3<f64>)) -> f64 {
-    let gap = (a.0 - b.1).sup(&(b.0 - a.1)).sup(&Vector3::zeros());
-    gap.norm()
 }

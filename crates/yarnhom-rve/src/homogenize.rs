@@ -3,13 +3,13 @@
 use nalgebra::Vector3;
 use yarnhom_geom::{MacroStrain, StrainError};
 
-use crate::assembly::RveState;
+use crate::assembly::{RveState, Want, assemble};
 use crate::model::RveModel;
 use crate::placement::Placement;
-use crate::solve::{SolveOptions, SolveReport, solve};
+use crate::solve::{SolveOptions, SolveReport, constraints, multipliers, solve};
 
-/// Central-difference steps for the stress: strain (dimensionless) and curvature (in units of
-/// one over the tile's mean period, so that the step bends the tile by a similar amount).
+/// Central-difference steps of the solve-based stress: strain (dimensionless) and curvature (in
+/// units of one over the tile's mean period, so that the step bends the tile by a similar amount).
 const STRAIN_STEP: f64 = 1e-3;
 
 /// The placement of the tile under `strain`.
@@ -38,6 +38,53 @@ pub fn solve_at(
     (report, state)
 }
 
+/// Strain steps of the embedding derivative in [`stress_at_equilibrium`]: no solve is repeated,
+/// so the step only trades truncation against round-off of the energy.
+const EMBEDDING_STEP: f64 = 1e-6;
+
+/// Homogenized stress `dΨ/d(sx, sa, sy, kx, ky)` (3.23c) at the equilibrium `state` of `strain`,
+/// from the forces the yarns exert at equilibrium, without another solve.
+///
+/// At equilibrium `∂E/∂g = Cᵀλ`, so the strain derivative of the equilibrium energy is the
+/// derivative of the energy at fixed fluctuations `g` through the co-rotated embedding
+/// `x̄(s) = φ(X) + h n(X) + R(X) g` (3.23c: `Σ ∂E/∂x · ∂x̄/∂s`, which interior equilibrium
+/// reduces to the tile-boundary forces), minus the work of the constraint forces on the
+/// strain-dependent sliding constraint (3.29): `dE/ds = ∂E/∂s|_g - λᵀ (∂C/∂s) g`. The
+/// embedding derivative `∂x̄/∂s` is taken by central differences of the placement (pure
+/// geometry, exact to `O(h²)`). Divided by the tile area (3.22).
+pub fn stress_at_equilibrium(model: &RveModel, strain: &MacroStrain, state: &RveState) -> [f64; 5] {
+    let here = placement(model, strain);
+    let c = constraints(model, &here);
+    let lambda = multipliers(&c, &assemble(model, &here, state, &state.g, Want::EnergyGradient).gradient);
+    let base = strain_vector(strain);
+    let mut stress = [0.0; 5];
+    for (k, slot) in stress.iter_mut().enumerate() {
+        let h = EMBEDDING_STEP * if k < 3 { 1.0 } else { curvature_unit(model) };
+        let at = |sign: f64| {
+            let mut s = base;
+            s[k] += sign * h;
+            let shifted = placement(model, &strain_from_vector(s).unwrap_or(*strain));
+            let energy = assemble(model, &shifted, state, &state.g, Want::EnergyGradient).energy_j;
+            (energy, constraints(model, &shifted) * &state.g)
+        };
+        let ((e_plus, c_plus), (e_minus, c_minus)) = (at(1.0), at(-1.0));
+        let constraint_work = lambda.dot(&(c_plus - c_minus));
+        *slot = (e_plus - e_minus - constraint_work) / (2.0 * h) / model.area_m2();
+    }
+    stress
+}
+
+/// One over the tile's mean period (1/m): the curvature that bends the tile by about a radian,
+/// the unit of curvature steps.
+fn curvature_unit(model: &RveModel) -> f64 {
+    2.0 / (model.period_m[0] + model.period_m[1])
+}
+
+/// `(sx, sa, sy, kx, ky)`.
+pub fn strain_vector(strain: &MacroStrain) -> [f64; 5] {
+    [strain.s.sx, strain.s.sa, strain.s.sy, strain.kx, strain.ky]
+}
+
 /// `dΨ/d(sx, sa, sy, kx, ky)` at `strain` by central differences of solves warm-started from the
 /// equilibrium `state` (the check route of Sec. 3.2.2; the thesis used it for bending stress in
 /// Ch. 6). `None` if any of the ten solves fails to converge.
@@ -46,8 +93,8 @@ pub fn stress_by_finite_differences(
     strain: &MacroStrain,
     state: &RveState,
 ) -> Option<[f64; 5]> {
-    let curvature_step = STRAIN_STEP * 2.0 / (model.period_m[0] + model.period_m[1]);
-    let base = [strain.s.sx, strain.s.sa, strain.s.sy, strain.kx, strain.ky];
+    let curvature_step = STRAIN_STEP * curvature_unit(model);
+    let base = strain_vector(strain);
     let options = SolveOptions::warm_started();
     let mut stress = [0.0; 5];
     for (k, slot) in stress.iter_mut().enumerate() {
@@ -56,7 +103,7 @@ pub fn stress_by_finite_differences(
         for (side, sign) in [1.0, -1.0].into_iter().enumerate() {
             let mut s = base;
             s[k] += sign * h;
-            let shifted = shifted_strain(s).ok()?;
+            let shifted = strain_from_vector(s).ok()?;
             let (report, _) = solve_at(model, &shifted, Some(state), &options);
             energies[side] = if report.converged { report.energy_density_j_m2 } else { return None };
         }
@@ -65,6 +112,7 @@ pub fn stress_by_finite_differences(
     Some(stress)
 }
 
-fn shifted_strain(s: [f64; 5]) -> Result<MacroStrain, StrainError> {
+/// The macro strain `(sx, sa, sy, kx, ky)`, validated.
+pub fn strain_from_vector(s: [f64; 5]) -> Result<MacroStrain, StrainError> {
     MacroStrain::new(s[0], s[1], s[2], s[3], s[4])
 }

@@ -12,16 +12,21 @@
 //! - [`assembly`]: energy, gradient and Hessian over `g`;
 //! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
-//! - [`homogenize`]: energy density and stress at a macro strain.
+//! - [`homogenize`]: energy density and stress at a macro strain;
+//! - [`relax`]: rest states (Algorithm 2, Sec. 6.5.2).
 
 pub mod assembly;
+pub mod broadphase;
+pub mod ccd;
 pub mod homogenize;
 pub mod linear;
 pub mod model;
 pub mod placement;
+pub mod relax;
 pub mod solve;
 
 pub use assembly::Assembled;
 pub use model::{RveError, RveModel};
 pub use placement::Placement;
+pub use relax::{RelaxError, RelaxMethod, RelaxOptions, RelaxReport, relax};
 pub use solve::{SolveOptions, SolveReport, StopReason, solve};

@@ -1,56 +1,145 @@
-//! Sparse symmetric positive definite solves with faer, reusing the symbolic Cholesky analysis
-//! while the sparsity pattern stays the same (it changes only when contacts appear or vanish).
+//! Sparse symmetric positive definite solves with faer, on a symbolic Cholesky analysis that is
+//! kept for a sparsity pattern that only grows. A matrix whose nonzeros lie inside the analysed
+//! pattern is factored on it (the entries it lacks are explicit zeros); one with an entry outside
+//! it triggers the analysis of the union of both patterns. In a tile solve the pattern changes
+//! only when contact pairs appear or vanish (A.2.3), so an analysis is needed only the first time
+//! a pair of edges meets.
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Argsort, Pair, SparseColMat, SymbolicSparseColMat};
+use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
 use faer::{MatMut, Side};
 
 /// The matrix was not positive definite (or the factorization failed otherwise).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NotPositiveDefinite;
 
-/// A Cholesky factorization of `A + shift I`, and the cached symbolic analysis behind it.
+/// A lower-triangle sparsity pattern (always with the full diagonal) and its symbolic Cholesky
+/// factorization.
+struct Analysis {
+    structure: SymbolicSparseColMat<usize>,
+    llt: SymbolicLlt<usize>,
+    /// Value slot of each diagonal entry.
+    diagonal: Vec<usize>,
+}
+
+impl Analysis {
+    /// Analyse the `n x n` pattern of the lower-triangle positions `entries` (any order, repeats
+    /// allowed) and the diagonal.
+    fn new(n: usize, entries: impl Iterator<Item = (usize, usize)>) -> Result<Self, NotPositiveDefinite> {
+        let pairs: Vec<Pair<usize, usize>> =
+            entries.chain((0..n).map(|i| (i, i))).map(|(row, col)| Pair { row, col }).collect();
+        let (structure, _) =
+            SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).map_err(|_| NotPositiveDefinite)?;
+        let llt = SymbolicLlt::try_new(structure.as_ref(), Side::Lower).map_err(|_| NotPositiveDefinite)?;
+        let mut analysis = Analysis { structure, llt, diagonal: Vec::new() };
+        analysis.diagonal =
+            (0..n).map(|i| analysis.slot(i, i).ok_or(NotPositiveDefinite)).collect::<Result<_, _>>()?;
+        Ok(analysis)
+    }
+
+    fn size(&self) -> usize {
+        self.structure.ncols()
+    }
+
+    /// The positions `(row, column)` of the pattern.
+    fn entries(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        (0..self.size())
+            .flat_map(move |col| self.structure.row_idx_of_col_raw(col).iter().map(move |&row| (row, col)))
+    }
+
+    /// Where the value of entry `(row, col)` is stored, if it is in the pattern (rows are sorted
+    /// within each column).
+    fn slot(&self, row: usize, col: usize) -> Option<usize> {
+        let range = self.structure.col_range(col);
+        let rows = &self.structure.row_idx()[range.clone()];
+        rows.binary_search(&row).ok().map(|k| range.start + k)
+    }
+
+    /// The value slot of every triplet (`None` above the diagonal, which is not read) into
+    /// `slots`; whether all lower-triangle triplets are in the pattern.
+    fn map_slots(&self, triplets: &[(usize, usize, f64)], slots: &mut Vec<Option<usize>>) -> bool {
+        slots.clear();
+        let mut covered = true;
+        slots.extend(triplets.iter().map(|&(i, j, _)| {
+            let slot = if i >= j { self.slot(i, j) } else { None };
+            covered &= i < j || slot.is_some();
+            slot
+        }));
+        covered
+    }
+}
+
+/// A Cholesky factorization of `A + shift I`, and the growing symbolic analysis behind it.
 #[derive(Default)]
 pub struct SpdSolver {
-    pattern: Vec<(usize, usize)>,
-    symbolic: Option<(SymbolicSparseColMat<usize>, Argsort<usize>, SymbolicLlt<usize>)>,
+    analysis: Option<Analysis>,
+    /// Positions of the triplets of the last call, and the value slot of each.
+    positions: Vec<(usize, usize)>,
+    slots: Vec<Option<usize>>,
+    /// Values of the analysed pattern.
+    values: Vec<f64>,
     factor: Option<Llt<usize, f64>>,
     /// How many symbolic analyses were computed (for statistics).
     pub symbolic_analyses: usize,
 }
 
 impl SpdSolver {
-    /// Factor `A + shift I` for the symmetric matrix `A` given as triplets (duplicates summed;
-    /// only the lower triangle is read).
+    /// Factor `A + shift I` for the symmetric `n x n` matrix `A` given as triplets (duplicates
+    /// summed; only the lower triangle is read).
     pub fn factor(
         &mut self,
         n: usize,
         triplets: &[(usize, usize, f64)],
         shift: f64,
     ) -> Result<(), NotPositiveDefinite> {
-        let mut entries: Vec<(usize, usize, f64)> =
-            triplets.iter().copied().filter(|&(i, j, _)| i >= j).collect();
-        entries.extend((0..n).map(|i| (i, i, shift)));
-        let pattern: Vec<(usize, usize)> = entries.iter().map(|&(i, j, _)| (i, j)).collect();
-        if self.symbolic.is_none() || pattern != self.pattern {
-            let pairs: Vec<Pair<usize, usize>> =
-                pattern.iter().map(|&(row, col)| Pair { row, col }).collect();
-            let (symbolic, argsort) =
-                SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).map_err(|_| NotPositiveDefinite)?;
-            let llt =
-                SymbolicLlt::try_new(symbolic.as_ref(), Side::Lower).map_err(|_| NotPositiveDefinite)?;
-            self.symbolic = Some((symbolic, argsort, llt));
-            self.pattern = pattern;
-            self.symbolic_analyses += 1;
+        if !self.same_positions(n, triplets) {
+            self.map_positions(n, triplets)?;
         }
-        let (symbolic, argsort, llt) = self.symbolic.as_ref().ok_or(NotPositiveDefinite)?;
-        let values: Vec<f64> = entries.iter().map(|e| e.2).collect();
-        let matrix = SparseColMat::new_from_argsort(symbolic.clone(), argsort, &values)
-            .map_err(|_| NotPositiveDefinite)?;
-        let factor = Llt::try_new_with_symbolic(llt.clone(), matrix.as_ref(), Side::Lower)
+        let analysis = self.analysis.as_ref().ok_or(NotPositiveDefinite)?;
+        self.values.clear();
+        self.values.resize(analysis.structure.row_idx().len(), 0.0);
+        for (&(_, _, v), slot) in triplets.iter().zip(&self.slots) {
+            if let Some(k) = *slot {
+                self.values[k] += v;
+            }
+        }
+        for &k in &analysis.diagonal {
+            self.values[k] += shift;
+        }
+        let matrix = SparseColMatRef::new(analysis.structure.as_ref(), &self.values);
+        let factor = Llt::try_new_with_symbolic(analysis.llt.clone(), matrix, Side::Lower)
             .map_err(|_| NotPositiveDefinite)?;
         self.factor = Some(factor);
+        Ok(())
+    }
+
+    /// Whether `triplets` has the positions of the last call (then its value slots are known).
+    fn same_positions(&self, n: usize, triplets: &[(usize, usize, f64)]) -> bool {
+        self.analysis.as_ref().is_some_and(|a| a.size() == n)
+            && self.positions.len() == triplets.len()
+            && self.positions.iter().zip(triplets).all(|(&p, &(i, j, _))| p == (i, j))
+    }
+
+    /// Map the triplets' positions to value slots, first analysing the union of the analysed
+    /// pattern and theirs if some lie outside it.
+    fn map_positions(
+        &mut self,
+        n: usize,
+        triplets: &[(usize, usize, f64)],
+    ) -> Result<(), NotPositiveDefinite> {
+        let covered =
+            self.analysis.as_ref().is_some_and(|a| a.size() == n && a.map_slots(triplets, &mut self.slots));
+        if !covered {
+            let old = self.analysis.take().filter(|a| a.size() == n);
+            let new = triplets.iter().filter(|t| t.0 >= t.1).map(|&(i, j, _)| (i, j));
+            let analysis = Analysis::new(n, old.iter().flat_map(Analysis::entries).chain(new))?;
+            self.symbolic_analyses += 1;
+            analysis.map_slots(triplets, &mut self.slots);
+            self.analysis = Some(analysis);
+        }
+        self.positions.clear();
+        self.positions.extend(triplets.iter().map(|&(i, j, _)| (i, j)));
         Ok(())
     }
 
@@ -67,18 +156,74 @@ impl SpdSolver {
 mod tests {
     use super::*;
 
+    fn solve(s: &SpdSolver, b: &[f64]) -> Vec<f64> {
+        let mut x = b.to_vec();
+        s.solve_in_place(&mut x, 1);
+        x
+    }
+
+    fn close(x: &[f64], y: &[f64]) -> bool {
+        x.iter().zip(y).all(|(a, b)| (a - b).abs() < 1e-14)
+    }
+
     #[test]
     fn solves_a_small_spd_system_and_reuses_the_analysis() {
         // [[4, 1], [1, 3]] x = [1, 2] -> x = [1/11, 7/11].
         let a = [(0, 0, 4.0), (1, 0, 1.0), (0, 1, 1.0), (1, 1, 3.0)];
         let mut s = SpdSolver::default();
         s.factor(2, &a, 0.0).expect("SPD");
-        let mut x = vec![1.0, 2.0];
-        s.solve_in_place(&mut x, 1);
-        assert!((x[0] - 1.0 / 11.0).abs() < 1e-15 && (x[1] - 7.0 / 11.0).abs() < 1e-15);
+        assert!(close(&solve(&s, &[1.0, 2.0]), &[1.0 / 11.0, 7.0 / 11.0]));
         s.factor(2, &a, 1.0).expect("SPD");
         assert_eq!(s.symbolic_analyses, 1);
         let indefinite = [(0, 0, 1.0), (1, 0, 2.0), (1, 1, 1.0)];
         assert_eq!(s.factor(2, &indefinite, 0.0), Err(NotPositiveDefinite));
+    }
+
+    #[test]
+    fn the_pattern_grows_and_subsets_reuse_the_analysis() {
+        // Tridiagonal [2, -1] with one extra coupling (2, 0) = 0.5, duplicates split in two.
+        let full = [
+            (0, 0, 1.0),
+            (0, 0, 1.0),
+            (1, 1, 2.0),
+            (2, 2, 2.0),
+            (1, 0, -1.0),
+            (0, 1, -1.0),
+            (2, 1, -1.0),
+            (2, 0, 0.5),
+        ];
+        let b = [1.0, 0.0, 1.0];
+        // [[2, -1, .5], [-1, 2, -1], [.5, -1, 2]] x = b -> x = (2/3, 2/3, 2/3).
+        let x_full = [2.0 / 3.0; 3];
+        // Without the coupling: [[2, -1, 0], [-1, 2, -1], [0, -1, 2]] x = b -> x = (1, 1, 1).
+        let tridiagonal: Vec<_> = full.iter().copied().filter(|t| (t.0, t.1) != (2, 0)).collect();
+        let mut s = SpdSolver::default();
+        s.factor(3, &full, 0.0).expect("SPD");
+        assert_eq!(s.symbolic_analyses, 1);
+        assert!(close(&solve(&s, &b), &x_full));
+        // A subset of the pattern: reused, the missing entry is an explicit zero.
+        s.factor(3, &tridiagonal, 0.0).expect("SPD");
+        assert_eq!(s.symbolic_analyses, 1);
+        assert!(close(&solve(&s, &b), &[1.0, 1.0, 1.0]));
+
+        // Starting from the subset, the new entry (2, 0) grows the pattern once...
+        let mut s = SpdSolver::default();
+        s.factor(3, &tridiagonal, 0.0).expect("SPD");
+        s.factor(3, &full, 0.0).expect("SPD");
+        assert_eq!(s.symbolic_analyses, 2);
+        assert!(close(&solve(&s, &b), &x_full));
+        // ...and both patterns, in any order of triplets, reuse it from then on.
+        let mut reversed = full;
+        reversed.reverse();
+        for triplets in [&tridiagonal[..], &full[..], &reversed[..], &tridiagonal[..]] {
+            s.factor(3, triplets, 0.0).expect("SPD");
+        }
+        assert_eq!(s.symbolic_analyses, 2);
+        assert!(close(&solve(&s, &b), &[1.0, 1.0, 1.0]));
+        // A shift applies to the whole diagonal: (A + I) x = b.
+        s.factor(3, &full, 1.0).expect("SPD");
+        let x = solve(&s, &b);
+        let r = [3.0 * x[0] - x[1] + 0.5 * x[2], -x[0] + 3.0 * x[1] - x[2], 0.5 * x[0] - x[1] + 3.0 * x[2]];
+        assert!(close(&r, &b));
     }
 }

@@ -3,7 +3,7 @@
 use nalgebra::Vector3;
 use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel};
 use yarnhom_pattern::YarnNeighbours;
-use yarnhom_rod::{BendTwist, ContactLaw, RodMaterial};
+use yarnhom_rod::{BendTwist, ContactLaw, RodMaterial, StretchLaw};
 
 use crate::placement::Instance;
 
@@ -15,9 +15,6 @@ pub enum RveError {
         "pattern '{0}' has no rest state; relax it first (yarnhom rve relax) or import a pattern with one"
     )]
     MissingRestState(String),
-    /// The yarn model family is not supported by this solver yet.
-    #[error("yarn model '{0}': {1}")]
-    UnsupportedModel(String, String),
     /// Model and pattern disagree on the yarn radius.
     #[error(
         "yarn model radius {model_m} m differs from the pattern's yarn radius {pattern_m} m by more than 5%"
@@ -109,22 +106,13 @@ impl RveModel {
     /// `model` (Ch. 3-5: Table 4.1 parameters).
     pub fn new(pattern: &Pattern, model: &YarnModel) -> Result<Self, RveError> {
         let rest = pattern.rest.as_ref().ok_or_else(|| RveError::MissingRestState(pattern.name.clone()))?;
-        let YarnMechanics::ElasticRod { youngs_modulus_pa, shear_modulus_pa, gamma, contact_stiffness_kg_s2 } =
-            model.mechanics
-        else {
-            return Err(RveError::UnsupportedModel(
-                model.name.clone(),
-                "the Ch. 6 biphasic model is not wired into the tile yet; use an elastic-rod model".into(),
-            ));
-        };
+        let (material_law, contact) = rod_laws(model);
         let (r_lo, r_hi) = pattern.radius_range_m();
         for r in [r_lo, r_hi] {
             if (r / model.radius_m - 1.0).abs() > 0.05 {
                 return Err(RveError::RadiusMismatch { model_m: model.radius_m, pattern_m: r });
             }
         }
-        let material_law = RodMaterial::circular(youngs_modulus_pa, shear_modulus_pa, gamma, model.radius_m);
-        let contact = ContactLaw::Kaldor { stiffness: contact_stiffness_kg_s2, radius_m: model.radius_m };
         let n = pattern.vertex_count();
         let centre =
             pattern.positions_m.iter().fold(Vector3::zeros(), |c, p| c + Vector3::from(*p)) / n as f64;
@@ -216,6 +204,26 @@ impl RveModel {
     /// Tile area `P1 P2` (m²): homogenized densities are per unit undeformed area (3.22).
     pub fn area_m2(&self) -> f64 {
         self.period_m[0] * self.period_m[1]
+    }
+}
+
+/// The rod and contact laws of a yarn model: Table 4.1's elastic rods with Kaldor contact
+/// (Ch. 3-5), or the Ch. 6 model: biphasic stretch (6.5), isotropic bending without twisting
+/// stiffness (6.6) and the two-phase contact barrier (6.7).
+fn rod_laws(model: &YarnModel) -> (RodMaterial, ContactLaw) {
+    match model.mechanics {
+        YarnMechanics::ElasticRod { youngs_modulus_pa, shear_modulus_pa, gamma, contact_stiffness_kg_s2 } => (
+            RodMaterial::circular(youngs_modulus_pa, shear_modulus_pa, gamma, model.radius_m),
+            ContactLaw::Kaldor { stiffness: contact_stiffness_kg_s2, radius_m: model.radius_m },
+        ),
+        YarnMechanics::Biphasic { k_s1_n, k_s2_n, eps_bar, k_b_nm2, r1_m, k_c1_n_m, r2_m, k_c2_n_m } => (
+            RodMaterial {
+                stretch: StretchLaw::Biphasic { k_s1_n, k_s2_n, eps_bar },
+                bend_stiffness_nm2: [k_b_nm2; 2],
+                twist_stiffness_nm2: 0.0,
+            },
+            ContactLaw::TwoPhase { outer: (r1_m, k_c1_n_m), inner: (r2_m, k_c2_n_m) },
+        ),
     }
 }
 

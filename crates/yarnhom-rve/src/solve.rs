@@ -12,7 +12,9 @@
 //!   then shortened tenfold until the energy decreases (A.2.3);
 //! - convergence when the gradient projected on the constraints' tangent space falls below
 //!   `ε_z = 1e-5` of its value at the affine start (A.31-A.33; measured against the affine start
-//!   rather than the first iterate, so that a warm start is held to the same absolute accuracy).
+//!   rather than the first iterate, so that a warm start is held to the same absolute accuracy,
+//!   and at least against the forces of a 0.1% stretch, see [`force_floor`]) and the constraints
+//!   hold to `ε_L r` (A.2.3).
 
 use nalgebra::{DMatrix, DVector, Vector2};
 
@@ -20,6 +22,9 @@ use crate::assembly::{RveState, Want, assemble};
 use crate::linear::SpdSolver;
 use crate::model::RveModel;
 use crate::placement::Placement;
+
+/// `ε_L` of App. A.2.3: constraints hold to this fraction of the yarn radius at convergence.
+const CONSTRAINT_TOLERANCE: f64 = 1e-4;
 
 /// Solver settings (defaults: App. A.2.3).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -90,7 +95,7 @@ pub struct SolveReport {
 }
 
 /// The constraint rows `C` (dense, few) of the tile under `placement`.
-fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f64> {
+pub(crate) fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f64> {
     let n = model.dof_count();
     let m = 3 + 2 * model.yarns.len();
     let mut c = DMatrix::zeros(m, n);
@@ -114,11 +119,14 @@ fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f64> {
     c
 }
 
+/// The least-squares constraint multipliers `λ` of `∇E ≈ Cᵀλ`: the constraint forces.
+pub(crate) fn multipliers(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
+    (c * c.transpose()).lu().solve(&(c * gradient)).unwrap_or_else(|| DVector::zeros(c.nrows()))
+}
+
 /// Gradient projected onto the tangent space of `C g = d` (A.31-A.32).
 fn projected(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
-    let cct = c * c.transpose();
-    let lambda = cct.lu().solve(&(c * gradient)).unwrap_or_else(|| DVector::zeros(c.nrows()));
-    gradient - c.transpose() * lambda
+    gradient - c.transpose() * multipliers(c, gradient)
 }
 
 /// Find the tile's equilibrium from `state` (warm or affine start), updating it in place.
@@ -131,15 +139,18 @@ pub fn solve(
     let n = model.dof_count();
     let r = model.radius_m;
     let c = constraints(model, placement);
-    let target = &c * &state.g;
+    let affine = RveState::affine(model, placement);
+    // The constraint values are those of the affine start (zero mean fluctuation, the pattern's
+    // total twist, boundary vertices on the boundary), also for a warm start: its own values
+    // were taken under another strain's boundary normal, and the step restores these.
+    let target = &c * &affine.g;
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * r });
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
     let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
     let mut solver = SpdSolver::default();
-    let affine = RveState::affine(model, placement);
-    let first = projected(&c, &assemble(model, placement, &affine, &affine.g, Want::Derivatives).gradient)
+    let first = projected(&c, &assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .norm()
-        .max(f64::MIN_POSITIVE);
+        .max(force_floor(model));
     let mut current = assemble(model, placement, state, &state.g, Want::Derivatives);
     let report =
         |reason: StopReason, iterations: usize, energy: f64, ratio: f64, g: &DVector<f64>, analyses| {
@@ -156,7 +167,8 @@ pub fn solve(
         };
     for iteration in 0..options.max_iterations {
         let ratio = projected(&c, &current.gradient).norm() / first;
-        if ratio < options.tolerance {
+        let feasible = (&c * &state.g - &target).amax() < CONSTRAINT_TOLERANCE * r;
+        if ratio < options.tolerance && feasible {
             return report(
                 StopReason::Converged,
                 iteration,
@@ -199,7 +211,7 @@ pub fn solve(
         let mut accepted = None;
         for _ in 0..12 {
             let trial = &state.g + &step * length;
-            let e = assemble(model, placement, state, &trial, Want::Energy).energy_j;
+            let e = assemble(model, placement, state, &trial, Want::EnergyGradient).energy_j;
             if e < current.energy_j {
                 accepted = Some(trial);
                 break;
@@ -229,6 +241,13 @@ pub fn solve(
         &state.g,
         solver.symbolic_analyses,
     )
+}
+
+/// The smallest reference of (A.33): the force norm of a 0.1% stretch of every edge. A tile
+/// whose affine start is already (nearly) in equilibrium, like a relaxed pattern at zero strain,
+/// is held to this absolute accuracy instead of a fraction of its own vanishing first gradient.
+fn force_floor(model: &RveModel) -> f64 {
+    model.material_law.stretch.density(1e-3).1 * (model.vertices as f64).sqrt()
 }
 
 /// The step of the regularized, constrained Newton system by the range-space method:

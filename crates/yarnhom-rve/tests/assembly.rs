@@ -70,7 +70,7 @@ fn assembled_derivatives_match_finite_differences() {
             );
         }
     }
-    let energy_only = assemble(&model, &placement, &state, &state.g, Want::Energy);
+    let energy_only = assemble(&model, &placement, &state, &state.g, Want::EnergyGradient);
     assert!((energy_only.energy_j - at.energy_j).abs() < 1e-12 * at.energy_j);
 }
 
@@ -81,8 +81,8 @@ fn a_two_by_one_tiling_has_the_same_energy_density() {
     for strain in ["sx=0.1", "sx=0.1,sa=0.1,sy=0.05", "kx=40", "ky=-60,sx=0.05"] {
         let (m1, p1, s1) = setup(&stock, "stock", strain);
         let (m2, p2, s2) = setup(&stock.tiled(2, 1), "stock", strain);
-        let d1 = assemble(&m1, &p1, &s1, &s1.g, Want::Energy).energy_j / m1.area_m2();
-        let d2 = assemble(&m2, &p2, &s2, &s2.g, Want::Energy).energy_j / m2.area_m2();
+        let d1 = assemble(&m1, &p1, &s1, &s1.g, Want::EnergyGradient).energy_j / m1.area_m2();
+        let d2 = assemble(&m2, &p2, &s2, &s2.g, Want::EnergyGradient).energy_j / m2.area_m2();
         assert!((d1 / d2 - 1.0).abs() < 1e-9, "{strain}: {d1} vs {d2} J/m²");
     }
 }

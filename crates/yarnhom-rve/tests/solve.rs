@@ -32,7 +32,7 @@ fn stockinette_stretched_30_percent_reaches_equilibrium() {
         &placement,
         &affine,
         &affine.g,
-        yarnhom_rve::assembly::Want::Energy,
+        yarnhom_rve::assembly::Want::EnergyGradient,
     )
     .energy_j;
     let (report, _) = solve_at(&model, "sx=0.3", None);
