@@ -227,10 +227,12 @@ pub fn diff_rve_solves(a: &RveSolve, b: &RveSolve, tol: Tolerance) -> Diff {
     if let (Some(x), Some(y)) = (a.energy_density_j_m2, b.energy_density_j_m2) {
         d.values("energy_density_j_m2", &[x], &[y], tol);
     }
-    match (a.stress_fd, b.stress_fd) {
-        (Some(x), Some(y)) => d.values("stress_fd", &x, &y, tol),
-        (None, None) => {}
-        _ => d.structural.push("stress present in only one file".into()),
+    for (name, x, y) in [("stress", a.stress, b.stress), ("stress_fd", a.stress_fd, b.stress_fd)] {
+        match (x, y) {
+            (Some(x), Some(y)) => d.values(name, &x, &y, tol),
+            (None, None) => {}
+            _ => d.structural.push(format!("{name} present in only one file")),
+        }
     }
     d.rows("positions_m", &a.positions_m, &b.positions_m, tol);
     d.values("edge_twist_rad", &a.edge_twist_rad, &b.edge_twist_rad, tol);

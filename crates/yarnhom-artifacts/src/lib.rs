@@ -144,12 +144,20 @@ macro_rules! artifact_kinds {
 
 impl Artifact for RveSolve {
     const KIND: &'static str = "rvesolve";
-    const SCHEMA_VERSION: u32 = 1;
+    const SCHEMA_VERSION: u32 = 2;
     fn validate(&self) -> std::result::Result<(), ValidationError> {
         RveSolve::validate(self)
     }
     fn summary(&self) -> String {
         RveSolve::summary(self)
+    }
+    /// Version 1 had no equilibrium stress (3.23c): it decodes with `stress` absent.
+    fn migrate(version: u32, payload: &[u8]) -> Result<Self> {
+        match version {
+            1 => rmp_serde::from_slice(payload)
+                .map_err(|e| Error::Decode { what: "rvesolve v1", message: e.to_string() }),
+            _ => Err(Error::NoMigration { kind: Self::KIND.into(), found: version, supported: 2 }),
+        }
     }
 }
 

@@ -36,9 +36,13 @@ pub struct RveSolve {
     pub stop_reason: String,
     /// Homogenized energy density (3.22) (J/m²); absent when not converged.
     pub energy_density_j_m2: Option<f64>,
-    /// Homogenized stress `dΨ/d(sx, sa, sy, kx, ky)` by central differences of warm-started
-    /// solves (J/m² per unit strain; J/m per unit curvature); absent when not converged or not
-    /// asked for.
+    /// Homogenized stress `dΨ/d(sx, sa, sy, kx, ky)` (3.23c) from the yarn forces at equilibrium
+    /// (J/m² per unit strain; J/m per unit curvature); absent when not converged or not asked
+    /// for. New in schema version 2 (absent in files of version 1).
+    #[serde(default)]
+    pub stress: Option<[f64; 5]>,
+    /// The same stress by central differences of warm-started solves (the check route of
+    /// Sec. 3.2.2); absent when not converged or not asked for.
     pub stress_fd: Option<[f64; 5]>,
     /// Newton iterations.
     pub iterations: u32,
@@ -66,14 +70,17 @@ impl RveSolve {
                 "present exactly when the solve converged (a failed solve reports no number)",
             ));
         }
-        if !self.converged && self.stress_fd.is_some() {
-            return Err(ValidationError::new("stress_fd", "a failed solve reports no stress"));
+        for (name, stress) in [("stress", &self.stress), ("stress_fd", &self.stress_fd)] {
+            match stress {
+                Some(_) if !self.converged => {
+                    return Err(ValidationError::new(name, "a failed solve reports no stress"));
+                }
+                Some(values) => check::finite(name, values)?,
+                None => {}
+            }
         }
         if let Some(e) = self.energy_density_j_m2 {
             check::finite("energy_density_j_m2", &[e])?;
-        }
-        if let Some(stress) = &self.stress_fd {
-            check::finite("stress_fd", stress)?;
         }
         Ok(())
     }
@@ -100,11 +107,13 @@ impl RveSolve {
             self.seconds,
             self.gradient_ratio,
         );
-        if let Some(st) = self.stress_fd {
-            out.push_str(&format!(
-                "\n  stress (finite differences): dsx {:.4e}, dsa {:.4e}, dsy {:.4e}, dkx {:.4e}, dky {:.4e}",
-                st[0], st[1], st[2], st[3], st[4]
-            ));
+        for (label, stress) in [("(3.23c)", self.stress), ("(finite differences)", self.stress_fd)] {
+            if let Some(st) = stress {
+                out.push_str(&format!(
+                    "\n  stress {label}: dsx {:.4e}, dsa {:.4e}, dsy {:.4e}, dkx {:.4e}, dky {:.4e}",
+                    st[0], st[1], st[2], st[3], st[4]
+                ));
+            }
         }
         out
     }

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, container};
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::{solve_at, stress_by_finite_differences};
+use yarnhom_rve::homogenize::{solve_at, stress_at_equilibrium, stress_by_finite_differences};
 use yarnhom_rve::relax::RelaxEvent;
 use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, StopReason};
 
@@ -17,7 +17,7 @@ use crate::inputs::{self, base_name, provenance};
 #[derive(Debug, Subcommand)]
 pub enum RveCommand {
     /// Solve the tile's elastostatic equilibrium under a macro strain and report the homogenized
-    /// energy density (3.22) and stress.
+    /// energy density (3.22) and stress (3.23c; `--fd-stress` adds the finite-difference check).
     ///
     /// The pattern needs a rest state (the published `.pyp` patterns have one). Exit status 0
     /// when the solve converged, 1 when it did not (the artifact is written anyway and says so,
@@ -68,9 +68,13 @@ pub struct SolveArgs {
     /// (`> -1`), shear `sa` (the cosine of the deformed axes' angle, `|sa| < 1`), curvatures (1/m).
     #[arg(long, allow_hyphen_values = true)]
     pub strain: String,
-    /// Skip the finite-difference stress (ten extra warm-started solves).
-    #[arg(long)]
+    /// Skip the homogenized stress.
+    #[arg(long, conflicts_with = "fd_stress")]
     pub no_stress: bool,
+    /// Also compute the stress by central differences of ten warm-started solves, the check of
+    /// the equilibrium stress (3.23c).
+    #[arg(long)]
+    pub fd_stress: bool,
     /// Newton iteration limit.
     #[arg(long, default_value_t = 2000)]
     pub max_iterations: usize,
@@ -131,7 +135,8 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let (report, state) = solve_at(&tile, &strain, None, &options);
     let seconds = started.elapsed().as_secs_f64();
-    let stress = (report.converged && !args.no_stress)
+    let stress = (report.converged && !args.no_stress).then(|| stress_at_equilibrium(&tile, &strain, &state));
+    let stress_fd = (report.converged && args.fd_stress)
         .then(|| stress_by_finite_differences(&tile, &strain, &state))
         .flatten();
     let placement = yarnhom_rve::homogenize::placement(&tile, &strain);
@@ -148,7 +153,8 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         converged: report.converged,
         stop_reason: stop_reason(report.reason).into(),
         energy_density_j_m2: report.converged.then_some(report.energy_density_j_m2),
-        stress_fd: stress,
+        stress,
+        stress_fd,
         iterations: report.iterations as u32,
         gradient_ratio: report.gradient_ratio,
         seconds,

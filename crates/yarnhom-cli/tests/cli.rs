@@ -203,6 +203,7 @@ fn every_command_explains_itself() {
         &["diff"],
         &["rve"],
         &["rve", "solve"],
+        &["rve", "relax"],
     ];
     for cmd in commands {
         let mut args = cmd.to_vec();
@@ -228,15 +229,18 @@ fn rve_solve_reports_energy_and_stress_and_refuses_bad_input() {
             "table4.1:stock-small",
             "--strain",
             "sx=0.2,sy=-0.05",
+            "--fd-stress",
             "-o",
             out_s,
         ],
         dir.path(),
     );
     assert!(text.contains("converged after"), "{text}");
-    assert!(text.contains("stress (finite differences)"), "{text}");
+    assert!(text.contains("stress (3.23c)") && text.contains("stress (finite differences)"), "{text}");
     let (_, solved) = container::read::<yarnhom_artifacts::RveSolve>(&out).expect("rvesolve reads back");
     assert!(solved.converged && solved.energy_density_j_m2.is_some_and(|e| e > 0.0));
+    let (stress, fd) = (solved.stress.expect("stress"), solved.stress_fd.expect("fd stress"));
+    assert!((stress[0] - fd[0]).abs() < 1e-2 * stress[0].abs(), "dsx: {stress:?} vs {fd:?}");
     assert_eq!(solved.positions_m.len(), 13);
     assert_eq!(yarnhom(&["diff", out_s, out_s], dir.path()).status.code(), Some(0));
     fails_with(
@@ -274,4 +278,36 @@ fn rve_solve_reports_energy_and_stress_and_refuses_bad_input() {
         dir.path(),
         "has no rest state",
     );
+}
+
+#[test]
+fn rve_relax_gives_a_generated_pattern_a_rest_state_without_in_plane_stress() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let generated = dir.path().join("g.pattern.yh");
+    let g = generated.to_str().expect("utf8");
+    ok(&["pattern", "generate", "stockinette", "-o", g], dir.path());
+    fails_with(
+        &["rve", "relax", g, "--model", "table4.1:stock", "--keep-rest-shape"],
+        dir.path(),
+        "needs a pattern with a rest state",
+    );
+    fails_with(
+        &["rve", "relax", g, "--model", "table4.1:stock", "--estimation", "1.5"],
+        dir.path(),
+        "strictly between 0 and 1",
+    );
+    let relaxed = dir.path().join("r.pattern.yh");
+    let r = relaxed.to_str().expect("utf8");
+    let text = ok(&["rve", "relax", g, "--model", "table4.1:stock", "-o", r], dir.path());
+    assert!(text.contains("in-plane stress at zero strain"), "{text}");
+    let (_, pattern) = container::read::<yarnhom_artifacts::Pattern>(&relaxed).expect("pattern reads back");
+    assert!(pattern.rest.is_some(), "a relaxed pattern carries its rest state");
+    // Pre-tension (Algorithm 2) shrinks the knit's periods.
+    assert!(pattern.period_m[0] < 8.4e-3 && pattern.period_m[1] < 4.4e-3, "{:?}", pattern.period_m);
+    let solved = dir.path().join("s.rvesolve.yh");
+    let text = ok(
+        &["rve", "solve", r, "--model", "table4.1:stock", "--strain", "sx=0", "-o", solved.to_str().expect("utf8")],
+        dir.path(),
+    );
+    assert!(text.contains("converged after"), "{text}");
 }

@@ -9,7 +9,7 @@ use yarnhom_rod::{
     BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
 };
 
-use crate::model::{BendElement, RveModel};
+use crate::model::{BendElement, RveModel, material_edge};
 use crate::placement::{Instance, Placement};
 
 /// Energy (J), gradient and Hessian triplets `(row, column, value)` (duplicates summed).
@@ -57,15 +57,11 @@ impl RveState {
             .iter()
             .map(|s| {
                 let v = s.from.vertex as usize;
-                let material_edge = model.material[s.to.vertex as usize]
-                    + Vector3::new(
-                        f64::from(s.to.image[0]) * model.period_m[0],
-                        f64::from(s.to.image[1]) * model.period_m[1],
-                        0.0,
-                    )
-                    - model.material[v];
                 let r = placement.rotation(s.from);
-                let flat = EdgeFrame::new(material_edge.into(), model.material_directors[v]);
+                let flat = EdgeFrame::new(
+                    material_edge(&model.material, model.period_m, s).into(),
+                    model.material_directors[v],
+                );
                 let rotate = |a: [f64; 3]| (r * Vector3::from(a)).into();
                 let corotated = EdgeFrame { tangent: rotate(flat.tangent), director: rotate(flat.director) };
                 corotated.updated(world_edge(model, placement, &g, s.from, s.to).into())

@@ -56,10 +56,6 @@ pub struct BendElement {
 pub struct YarnInfo {
     /// Its vertices.
     pub vertices: Vec<u32>,
-    /// Tile offset after one pass along the yarn.
-    pub closure: [i32; 2],
-    /// A vertex whose outgoing edge crosses the tile boundary: held on the boundary (3.29).
-    pub boundary_vertex: u32,
 }
 
 /// The tile: topology, rest state and materials. Edges are indexed by their source vertex.
@@ -92,9 +88,11 @@ pub struct RveModel {
     pub rest_length_m: Vec<f64>,
     /// Smallest yarn radius (m): the scale of step limits and tolerances.
     pub radius_m: f64,
-    /// The yarns: vertices, closure offset, and the vertex held on the tile boundary by the
-    /// sliding constraint (3.29).
+    /// The yarns: vertices and closure offset.
     pub yarns: Vec<YarnInfo>,
+    /// Unit tangent of the yarn at each vertex in the material configuration (the mean of its
+    /// two edges' directions): the sliding direction the solver's constraints hold still.
+    pub material_tangents: Vec<Vector3<f64>>,
     /// Tile images whose edges can come within contact reach of the tile's own edges: yarns
     /// reach out of their tile (loops are wider than stitches), so this may go beyond the 8
     /// neighbours.
@@ -157,18 +155,22 @@ impl RveModel {
         let yarns = pattern
             .yarns
             .iter()
-            .map(|y| {
-                let crossing = y.edge_offsets.iter().position(|o| *o != [0, 0]).unwrap_or(0);
-                YarnInfo {
-                    vertices: y.vertices.clone(),
-                    closure: y.closure_offset(),
-                    boundary_vertex: y.vertices[crossing],
-                }
+            .map(|y| YarnInfo { vertices: y.vertices.clone() })
+            .collect();
+        let material_tangents = (0..n)
+            .map(|v| {
+                let s_in = &stretch[incoming[v].0 as usize];
+                let s_out = &stretch[v];
+                (material_edge(&material, pattern.period_m, s_in)
+                    .normalize()
+                    + material_edge(&material, pattern.period_m, s_out).normalize())
+                .normalize()
             })
             .collect();
         let images = contact_images(&material, pattern.period_m, contact.reach_m() * 1.5);
         Ok(RveModel {
             yarns,
+            material_tangents,
             images,
             vertices: n,
             period_m: pattern.period_m,
@@ -205,6 +207,14 @@ impl RveModel {
     pub fn area_m2(&self) -> f64 {
         self.period_m[0] * self.period_m[1]
     }
+}
+
+/// The vector of a stretch element's edge in the material configuration.
+pub fn material_edge(material: &[Vector3<f64>], period_m: [f64; 2], s: &StretchElement) -> Vector3<f64> {
+    let offset = |i: Instance| {
+        Vector3::new(f64::from(i.image[0]) * period_m[0], f64::from(i.image[1]) * period_m[1], 0.0)
+    };
+    material[s.to.vertex as usize] + offset(s.to) - material[s.from.vertex as usize] - offset(s.from)
 }
 
 /// The rod and contact laws of a yarn model: Table 4.1's elastic rods with Kaldor contact

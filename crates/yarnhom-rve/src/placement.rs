@@ -25,8 +25,19 @@ pub struct Placement {
 impl Placement {
     /// The placement of a tile with material points `material` (m) and periods `period_m`
     /// under `strain`.
+    ///
+    /// The midsurface covers every instance the tile's elements and contacts place: the
+    /// material points' box widened on each side by its own extent plus two periods (images
+    /// within contact reach lie inside it). For doubly curved strains it is the least-squares
+    /// solution of (3.17-3.18) on that box; otherwise the exact closed form.
     pub fn new(material: Vec<Vector3<f64>>, period_m: [f64; 2], strain: &MacroStrain) -> Self {
-        Placement { material, period_m, midsurface: Midsurface::new(strain) }
+        let (lo, hi) = material.iter().fold(
+            (Vector2::repeat(f64::INFINITY), Vector2::repeat(f64::NEG_INFINITY)),
+            |(lo, hi), m| (lo.inf(&m.xy()), hi.sup(&m.xy())),
+        );
+        let margin = (hi - lo) + Vector2::new(period_m[0], period_m[1]) * 2.0;
+        let midsurface = Midsurface::over_domain(strain, lo - margin, hi + margin);
+        Placement { material, period_m, midsurface }
     }
 
     fn material_point(&self, i: Instance) -> (Vector2<f64>, f64) {

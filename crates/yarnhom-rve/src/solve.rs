@@ -2,8 +2,13 @@
 //!
 //! - constraints `C g = d`, kept exactly from a feasible start: translation (3.19, the mean of
 //!   the unrotated fluctuations is fixed), zero mean twist per yarn (3.28, the sum of edge twists
-//!   is kept), and sliding (3.29: one boundary vertex per yarn keeps its fluctuation along the
-//!   deformed boundary normal `S̄ N`); periodicity (3.21, 3.26-3.27) holds by construction;
+//!   is kept), and no sliding along the yarns: `Σ_i t_i · g_i = 0` per yarn, with `t_i` the
+//!   yarn's unit tangents in the affinely deformed tile. This removes the sliding nullspace
+//!   that (3.29) removes by pinning one vertex per yarn to the tile boundary; pinning a vertex
+//!   breaks the tile's mirror symmetries (a mirrored yarn runs the other way, so the pinned
+//!   vertex is not mirrored onto itself) and is a real constraint wherever rest shapes vary
+//!   along the yarn, where sliding costs energy: the relaxed stockinette then slants and its
+//!   shear response loses its symmetry. Periodicity (3.21, 3.26-3.27) holds by construction;
 //! - each step solves the scaled, regularized system (A.30) `(M H M + α I) w = -M ∇E` under the
 //!   constraints by the range-space method on one sparse Cholesky factorization, `δ = M w`, with
 //!   `M = 1` for positions and `10⁶ r` for twists, and `α = α̂ ‖M ∇E‖∞` decaying `α̂` from 5000 to 5
@@ -16,7 +21,7 @@
 //!   and at least against the forces of a 0.1% stretch, see [`force_floor`]) and the constraints
 //!   hold to `ε_L r` (A.2.3).
 
-use nalgebra::{DMatrix, DVector, Vector2};
+use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 use crate::assembly::{RveState, Want, assemble};
 use crate::linear::SpdSolver;
@@ -109,11 +114,12 @@ pub(crate) fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f6
         for &v in &yarn.vertices {
             c[(3 + 2 * y, model.twist_dof(v))] = 1.0;
         }
-        let closure = Vector2::new(f64::from(yarn.closure[0]), f64::from(yarn.closure[1]));
-        let normal = if closure.x.abs() >= closure.y.abs() { Vector2::x() } else { Vector2::y() };
-        let direction = (stretch * normal).normalize();
-        for k in 0..3 {
-            c[(4 + 2 * y, model.position_dof(yarn.boundary_vertex) + k)] = direction[k];
+        for &v in &yarn.vertices {
+            let t = model.material_tangents[v as usize];
+            let deformed = (stretch * Vector2::new(t.x, t.y) + Vector3::z() * t.z).normalize();
+            for k in 0..3 {
+                c[(4 + 2 * y, model.position_dof(v) + k)] = deformed[k];
+            }
         }
     }
     c
