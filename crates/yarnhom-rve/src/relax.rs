@@ -92,7 +92,7 @@ pub struct RelaxReport {
     /// Energy of the tile after the last reset's solve (J): below
     /// [`RelaxOptions::stress_free_energy_j`] when a stress-free state was reached.
     pub stress_free_energy_j: f64,
-    /// In-plane strain `(sx, sy)` applied to the periods at the end (Algorithm 2, line 14).
+    /// In-plane strain `(sx, sy)` applied to the periods in all (Algorithm 2, line 14).
     pub period_strain: [f64; 2],
     /// Homogenized in-plane stress `dΨ/d(sx, sa, sy)` (J/m²) of the result at zero strain.
     pub residual_stress_j_m2: [f64; 3],
@@ -155,9 +155,19 @@ pub fn relax(
         if !options.keep_rest_shape {
             pre_tension(&mut current);
         }
-        let (strain, iterations) = in_plane_minimum(&mut current, yarn, options, progress)?;
-        report.iterations += iterations;
-        report.period_strain = strain;
+        // Moving the pattern to the minimum changes the tangents of the sliding constraint,
+        // whose force then shifts the equilibrium a little: repeat until the moved pattern is
+        // itself at the minimum.
+        let mut total = [1.0, 1.0];
+        for _ in 0..MAX_PERIOD_ROUNDS {
+            let (strain, iterations) = in_plane_minimum(&mut current, yarn, options, progress)?;
+            report.iterations += iterations;
+            total = [total[0] * (1.0 + strain[0]), total[1] * (1.0 + strain[1])];
+            if strain == [0.0, 0.0] {
+                break;
+            }
+        }
+        report.period_strain = [total[0] - 1.0, total[1] - 1.0];
     } else {
         let tile = RveModel::new(&current, yarn)?;
         let (solved, state) = solve_at(&tile, &zero_strain(), None, &options.solve);
@@ -289,6 +299,8 @@ fn pre_tension(pattern: &mut Pattern) {
     }
 }
 
+/// Rounds of in-plane minimization and pattern update.
+const MAX_PERIOD_ROUNDS: usize = 4;
 /// Newton steps of the in-plane minimization.
 const MAX_PERIOD_STEPS: usize = 40;
 /// Largest change of a period strain in one step.

@@ -154,8 +154,8 @@ pub fn solve(
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
     let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
     let mut solver = SpdSolver::default();
-    let first = projected(&c, &assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
-        .norm()
+    let residual = |gradient: &DVector<f64>| projected(&c, gradient).norm();
+    let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
     let mut current = assemble(model, placement, state, &state.g, Want::Derivatives);
     let report =
@@ -172,7 +172,7 @@ pub fn solve(
             }
         };
     for iteration in 0..options.max_iterations {
-        let ratio = projected(&c, &current.gradient).norm() / first;
+        let ratio = residual(&current.gradient) / first;
         let feasible = (&c * &state.g - &target).amax() < CONSTRAINT_TOLERANCE * r;
         if ratio < options.tolerance && feasible {
             return report(
@@ -238,7 +238,7 @@ pub fn solve(
         state.update_frames(model, placement);
         current = assemble(model, placement, state, &state.g, Want::Derivatives);
     }
-    let ratio = projected(&c, &current.gradient).norm() / first;
+    let ratio = residual(&current.gradient) / first;
     report(
         StopReason::IterationLimit,
         options.max_iterations,
