@@ -150,6 +150,13 @@ pub fn solve(
     // total twist, boundary vertices on the boundary), also for a warm start: its own values
     // were taken under another strain's boundary normal, and the step restores these.
     let target = &c * &affine.g;
+    // A warm start met the constraints of another strain: move it onto these first (the
+    // least-norm correction; Newton steps then keep them exactly).
+    let violation = &c * &state.g - &target;
+    if violation.amax() > 0.0 {
+        state.g -= c.transpose() * (&c * c.transpose()).lu().solve(&violation).unwrap_or(violation);
+        state.update_frames(model, placement);
+    }
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * r });
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
     let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
