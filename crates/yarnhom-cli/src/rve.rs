@@ -9,7 +9,7 @@ use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, containe
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::{solve_at, stress_at_equilibrium, stress_by_finite_differences};
 use yarnhom_rve::relax::RelaxEvent;
-use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, StopReason};
+use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl, StopReason};
 
 use crate::Outcome;
 use crate::inputs::{self, base_name, provenance};
@@ -78,6 +78,10 @@ pub struct SolveArgs {
     /// Newton iteration limit.
     #[arg(long, default_value_t = 2000)]
     pub max_iterations: usize,
+    /// Keep steps collision-safe by additive continuous collision detection (Li et al. 2021)
+    /// with this smallest centreline distance in yarn radii, instead of the step limit of A.2.3.
+    #[arg(long, value_name = "MIN_SEPARATION_RADII")]
+    pub ccd: Option<f64>,
     /// Output file (default: PATTERN.rvesolve.yh, PATTERN the input's base name).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -124,7 +128,14 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     };
     let (model, model_input) = load_model(&args.model)?;
     let tile = RveModel::new(pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
-    let options = SolveOptions { max_iterations: args.max_iterations, ..SolveOptions::default() };
+    let step_control = match args.ccd {
+        Some(d) if !(d > 0.0 && d < 2.0) => {
+            anyhow::bail!("--ccd {d}: the separation must lie strictly between 0 and 2 yarn radii")
+        }
+        Some(min_separation_radii) => StepControl::AdditiveCcd { min_separation_radii },
+        None => StepControl::StepLimit,
+    };
+    let options = SolveOptions { max_iterations: args.max_iterations, step_control, ..SolveOptions::default() };
     eprintln!(
         "solving '{}' ({} vertices) with '{}' at {}",
         pattern.name,

@@ -302,7 +302,7 @@ fn shifted(i: Instance, o: [i32; 2]) -> Instance {
 
 /// Endpoints of every edge in every contact image ([`RveModel::images`]) at DOFs `g`, as
 /// `[image][edge]`.
-pub(crate) fn image_segments(
+pub fn image_segments(
     model: &RveModel,
     placement: &Placement,
     g: &DVector<f64>,

@@ -257,10 +257,17 @@ mod tests {
         assert_eq!(hits, (0..=20).collect::<Vec<_>>());
         grid.overlapping(&unit(f64::NAN), &mut hits);
         assert!(hits.is_empty());
+        // A box that is not finite is kept apart and meets nothing.
         boxes.push(unit(f64::NAN));
-        let degenerate = Grid::new(&boxes);
-        assert!(degenerate.entries.is_empty());
-        degenerate.overlapping(&unit(0.5), &mut hits);
+        let with_nan = Grid::new(&boxes);
+        assert_eq!(with_nan.wide, [20, 21]);
+        with_nan.overlapping(&unit(0.5), &mut hits);
         assert_eq!(hits, [0, 20]);
+        // Zero-size boxes give a zero cell: all are tested directly.
+        let points = [Aabb::around_segment(&Vector3::zeros(), &Vector3::zeros(), 0.0); 2];
+        let degenerate = Grid::new(&points);
+        assert!(degenerate.entries.is_empty());
+        degenerate.overlapping(&unit(0.0), &mut hits);
+        assert_eq!(hits, [0, 1]);
     }
 }

@@ -14,7 +14,8 @@
 //!   `M = 1` for positions and `10⁶ r` for twists, and `α = α̂ ‖M ∇E‖∞` decaying `α̂` from 5000 to 5
 //!   over 400 iterations; `α` grows tenfold whenever the factorization finds the matrix indefinite;
 //! - steps are limited so that no vertex moves more than `p r`, `p = 0.05 + 0.15 clamp(λ_min(I))`,
-//!   then shortened tenfold until the energy decreases (A.2.3);
+//!   or, with [`StepControl::AdditiveCcd`], cut by additive continuous collision detection, then
+//!   shortened tenfold until the energy decreases (A.2.3);
 //! - convergence when the gradient projected on the constraints' tangent space falls below
 //!   `ε_z = 1e-5` of its value at the affine start (A.31-A.33; measured against the affine start
 //!   rather than the first iterate, so that a warm start is held to the same absolute accuracy,
@@ -24,6 +25,7 @@
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 use crate::assembly::{RveState, Want, assemble};
+use crate::ccd::max_collision_free_step;
 use crate::linear::SpdSolver;
 use crate::model::RveModel;
 use crate::placement::Placement;
@@ -42,6 +44,21 @@ pub struct SolveOptions {
     pub regularization: (f64, f64),
     /// `N` of the regularization schedule.
     pub regularization_iterations: usize,
+    /// How a Newton step is kept from tunnelling yarns through each other.
+    pub step_control: StepControl,
+}
+
+/// Collision-safe steps (A.2.3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StepControl {
+    /// No vertex moves more than `p r` per step, `p = 0.05 + 0.15 clamp(λ_min(I), 0, 1)`.
+    StepLimit,
+    /// Additive continuous collision detection (Li et al. 2021; [`crate::ccd`]): the step is cut
+    /// where two yarn centrelines would come closer than `min_separation_radii` yarn radii.
+    AdditiveCcd {
+        /// Smallest centreline distance a step may reach, in yarn radii.
+        min_separation_radii: f64,
+    },
 }
 
 impl Default for SolveOptions {
@@ -51,6 +68,7 @@ impl Default for SolveOptions {
             tolerance: 1e-5,
             regularization: (5000.0, 5.0),
             regularization_iterations: 400,
+            step_control: StepControl::StepLimit,
         }
     }
 }
@@ -218,9 +236,16 @@ pub fn solve(
         }
         let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
             .component_mul(&scale);
-        let largest_move =
-            (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
-        let mut length = if largest_move > p * r { p * r / largest_move } else { 1.0 };
+        let mut length = match options.step_control {
+            StepControl::StepLimit => {
+                let largest_move =
+                    (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+                if largest_move > p * r { p * r / largest_move } else { 1.0 }
+            }
+            StepControl::AdditiveCcd { min_separation_radii } => {
+                max_collision_free_step(model, placement, state, &step, min_separation_radii * r)
+            }
+        };
         let mut accepted = None;
         for _ in 0..12 {
             let trial = &state.g + &step * length;

@@ -3,7 +3,7 @@
 use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::assembly::RveState;
-use yarnhom_rve::{Placement, RveModel, SolveOptions, SolveReport};
+use yarnhom_rve::{Placement, RveModel, SolveOptions, SolveReport, StepControl};
 
 fn published(name: &str) -> Pattern {
     let path = format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
@@ -105,3 +105,19 @@ fn stockinette_curls_and_its_two_edges_curl_opposite_ways() {
 }
 
 
+
+#[test]
+fn collision_detection_steps_reach_the_same_stretched_equilibrium() {
+    // Additive CCD in place of the step limit (A.2.3) changes the path, not the equilibrium.
+    let model = stock();
+    let strain: MacroStrain = "sx=0.3".parse().expect("strain");
+    let ccd = SolveOptions {
+        step_control: StepControl::AdditiveCcd { min_separation_radii: 0.5 },
+        ..SolveOptions::default()
+    };
+    let (limited, _) = solve_at(&model, "sx=0.3", None);
+    let (safe, _) = yarnhom_rve::homogenize::solve_at(&model, &strain, None, &ccd);
+    assert!(limited.converged && safe.converged, "{safe:?}");
+    let difference = (safe.energy_density_j_m2 / limited.energy_density_j_m2 - 1.0).abs();
+    assert!(difference < 1e-4, "step limit {limited:?} vs ccd {safe:?}");
+}
