@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's main command: yarnhom's pipeline on built-in defaults, printing where each
 # artifact went. Today: published and generated patterns, the Table 4.1 yarn models,
-# inspection, conversion (JSON, HDF5, .pyp), a periodic tile solve and semantic diff. Later
-# stages (relax -> sample -> fit -> simulate) join it as they land.
+# inspection, conversion (JSON, HDF5, .pyp), periodic tile solves, a rest-state relaxation and
+# semantic diff. Later stages (sample -> fit -> simulate) join it as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
@@ -33,6 +33,11 @@ yarnhom convert "$out/rib.pattern.yh" --to pyp -o "$out/rib.pyp"
 
 echo "== periodic tile solve: the published stockinette stretched 30% along X1 -> $out/stock-sx0.3.rvesolve.yh"
 yarnhom rve solve "$data/stock.pyp" --model table4.1:stock --strain sx=0.3 -o "$out/stock-sx0.3.rvesolve.yh"
+
+echo "== rest state (Algorithm 2): the generated stockinette relaxed with the Table 4.1 stock yarn -> $out/gen-stockinette.relaxed.pattern.yh"
+yarnhom rve relax "$out/gen-stockinette.pattern.yh" --model table4.1:stock -o "$out/gen-stockinette.relaxed.pattern.yh"
+yarnhom rve solve "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --strain sx=0.2 \
+  -o "$out/gen-stockinette-sx0.2.rvesolve.yh"
 
 echo "== semantic diff: the HDF5 export against the original (equal), stockinette against rib (different)"
 yarnhom diff "$out/rib.pattern.yh" "$out/rib.pattern.h5"

@@ -2,14 +2,14 @@
 //! Table 4.1 yarn models, cold (affine start) and warm-started from the solution at a nearby
 //! strain (1% more stretch or curvature).
 //! Compared with: thesis Table A.1, about 5.7 thread-seconds per sample for stockinette and 25
-//! for rib; yarnhom's target is under 0.2 s per cold stock solve on one core.
-//! Set `YARNHOM_BENCH_RIB=1` to include rib (about 16 s per cold solve).
+//! for rib; yarnhom's target is under 0.2 s per cold stock solve on one core. Stock at sx=0.3 is
+//! also solved with additive CCD steps in place of the step limit.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::solve_at;
-use yarnhom_rve::{RveModel, SolveOptions};
+use yarnhom_rve::{RveModel, SolveOptions, StepControl};
 
 fn tile(name: &str) -> RveModel {
     let path = format!("{}/../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
@@ -19,13 +19,9 @@ fn tile(name: &str) -> RveModel {
 }
 
 fn bench_solves(c: &mut Criterion) {
-    let mut names = vec!["stock"];
-    if std::env::var("YARNHOM_BENCH_RIB").is_ok() {
-        names.push("rib");
-    }
     let mut g = c.benchmark_group("rve solve");
     g.sample_size(10);
-    for name in names {
+    for name in ["stock", "rib"] {
         let model = tile(name);
         for (label, strain, nearby) in [("sx=0.3", "sx=0.3", "sx=0.303"), ("kx=40", "kx=40", "kx=40.4")] {
             let strain: MacroStrain = strain.parse().expect("strain");
@@ -44,6 +40,14 @@ fn bench_solves(c: &mut Criterion) {
             });
         }
     }
+    let model = tile("stock");
+    let strain: MacroStrain = "sx=0.3".parse().expect("strain");
+    let ccd = SolveOptions {
+        step_control: StepControl::AdditiveCcd { min_separation_radii: 0.5 },
+        ..SolveOptions::default()
+    };
+    eprintln!("stock sx=0.3 ccd: {} iterations", solve_at(&model, &strain, None, &ccd).0.iterations);
+    g.bench_function("stock sx=0.3 cold ccd", |b| b.iter(|| solve_at(&model, &strain, None, &ccd)));
     g.finish();
 }
 

@@ -135,7 +135,8 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         Some(min_separation_radii) => StepControl::AdditiveCcd { min_separation_radii },
         None => StepControl::StepLimit,
     };
-    let options = SolveOptions { max_iterations: args.max_iterations, step_control, ..SolveOptions::default() };
+    let options =
+        SolveOptions { max_iterations: args.max_iterations, step_control, ..SolveOptions::default() };
     eprintln!(
         "solving '{}' ({} vertices) with '{}' at {}",
         pattern.name,
@@ -220,7 +221,11 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
     let started = Instant::now();
     let mut show = |event: RelaxEvent| match event {
         RelaxEvent::Reset(k, energy) => {
-            eprintln!("  reset {:>3}: relaxed tile energy {energy:.3e} J ({:.1} s)", k + 1, started.elapsed().as_secs_f64())
+            eprintln!(
+                "  reset {:>3}: relaxed tile energy {energy:.3e} J ({:.1} s)",
+                k + 1,
+                started.elapsed().as_secs_f64()
+            )
         }
         RelaxEvent::PeriodStep(s, sigma) => eprintln!(
             "  periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m² ({:.1} s)",

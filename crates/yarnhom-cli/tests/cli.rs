@@ -306,7 +306,17 @@ fn rve_relax_gives_a_generated_pattern_a_rest_state_without_in_plane_stress() {
     assert!(pattern.period_m[0] < 8.4e-3 && pattern.period_m[1] < 4.4e-3, "{:?}", pattern.period_m);
     let solved = dir.path().join("s.rvesolve.yh");
     let text = ok(
-        &["rve", "solve", r, "--model", "table4.1:stock", "--strain", "sx=0", "-o", solved.to_str().expect("utf8")],
+        &[
+            "rve",
+            "solve",
+            r,
+            "--model",
+            "table4.1:stock",
+            "--strain",
+            "sx=0",
+            "-o",
+            solved.to_str().expect("utf8"),
+        ],
         dir.path(),
     );
     assert!(text.contains("converged after"), "{text}");

@@ -152,17 +152,12 @@ impl RveModel {
                 }
             })
             .collect();
-        let yarns = pattern
-            .yarns
-            .iter()
-            .map(|y| YarnInfo { vertices: y.vertices.clone() })
-            .collect();
+        let yarns = pattern.yarns.iter().map(|y| YarnInfo { vertices: y.vertices.clone() }).collect();
         let material_tangents = (0..n)
             .map(|v| {
                 let s_in = &stretch[incoming[v].0 as usize];
                 let s_out = &stretch[v];
-                (material_edge(&material, pattern.period_m, s_in)
-                    .normalize()
+                (material_edge(&material, pattern.period_m, s_in).normalize()
                     + material_edge(&material, pattern.period_m, s_out).normalize())
                 .normalize()
             })
@@ -222,10 +217,12 @@ pub fn material_edge(material: &[Vector3<f64>], period_m: [f64; 2], s: &StretchE
 /// stiffness (6.6) and the two-phase contact barrier (6.7).
 fn rod_laws(model: &YarnModel) -> (RodMaterial, ContactLaw) {
     match model.mechanics {
-        YarnMechanics::ElasticRod { youngs_modulus_pa, shear_modulus_pa, gamma, contact_stiffness_kg_s2 } => (
-            RodMaterial::circular(youngs_modulus_pa, shear_modulus_pa, gamma, model.radius_m),
-            ContactLaw::Kaldor { stiffness: contact_stiffness_kg_s2, radius_m: model.radius_m },
-        ),
+        YarnMechanics::ElasticRod { youngs_modulus_pa, shear_modulus_pa, gamma, contact_stiffness_kg_s2 } => {
+            (
+                RodMaterial::circular(youngs_modulus_pa, shear_modulus_pa, gamma, model.radius_m),
+                ContactLaw::Kaldor { stiffness: contact_stiffness_kg_s2, radius_m: model.radius_m },
+            )
+        }
         YarnMechanics::Biphasic { k_s1_n, k_s2_n, eps_bar, k_b_nm2, r1_m, k_c1_n_m, r2_m, k_c2_n_m } => (
             RodMaterial {
                 stretch: StretchLaw::Biphasic { k_s1_n, k_s2_n, eps_bar },

@@ -31,10 +31,11 @@ impl Placement {
     /// within contact reach lie inside it). For doubly curved strains it is the least-squares
     /// solution of (3.17-3.18) on that box; otherwise the exact closed form.
     pub fn new(material: Vec<Vector3<f64>>, period_m: [f64; 2], strain: &MacroStrain) -> Self {
-        let (lo, hi) = material.iter().fold(
-            (Vector2::repeat(f64::INFINITY), Vector2::repeat(f64::NEG_INFINITY)),
-            |(lo, hi), m| (lo.inf(&m.xy()), hi.sup(&m.xy())),
-        );
+        let (lo, hi) = material
+            .iter()
+            .fold((Vector2::repeat(f64::INFINITY), Vector2::repeat(f64::NEG_INFINITY)), |(lo, hi), m| {
+                (lo.inf(&m.xy()), hi.sup(&m.xy()))
+            });
         let margin = (hi - lo) + Vector2::new(period_m[0], period_m[1]) * 2.0;
         let midsurface = Midsurface::over_domain(strain, lo - margin, hi + margin);
         Placement { material, period_m, midsurface }

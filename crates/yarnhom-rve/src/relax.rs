@@ -139,7 +139,9 @@ pub fn relax(
             }
             current = configured(&current, &tile, &zero_strain(), &state);
             let bound = match options.method {
-                RelaxMethod::Estimation { max_length_change } => Some((&input_lengths[..], max_length_change)),
+                RelaxMethod::Estimation { max_length_change } => {
+                    Some((&input_lengths[..], max_length_change))
+                }
                 RelaxMethod::Reference => None,
             };
             current = at_rest(&current, yarn, bound)?;

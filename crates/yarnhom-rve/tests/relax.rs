@@ -86,10 +86,7 @@ fn a_mirror_symmetric_knit_keeps_a_symmetric_shear_response() {
         let (plus, _, _) = solve(&tile, &format!("sa={sa}"));
         let (minus, _, _) = solve(&tile, &format!("sa=-{sa}"));
         assert!(plus > rest, "shearing stores energy");
-        assert!(
-            (plus - minus).abs() < 1e-4 * (plus - rest),
-            "sa = ±{sa}: {plus} vs {minus} (rest {rest})"
-        );
+        assert!((plus - minus).abs() < 1e-4 * (plus - rest), "sa = ±{sa}: {plus} vs {minus} (rest {rest})");
     }
 }
 
@@ -117,8 +114,10 @@ fn the_estimation_keeps_rest_lengths_within_their_bound() {
     // Sec. 6.5.2 on the published stockinette: rest lengths stay within 20% of the input's, and
     // the estimated rest state is an equilibrium at zero strain.
     let input = published("stock");
-    let options =
-        RelaxOptions { method: RelaxMethod::Estimation { max_length_change: 0.2 }, ..RelaxOptions::default() };
+    let options = RelaxOptions {
+        method: RelaxMethod::Estimation { max_length_change: 0.2 },
+        ..RelaxOptions::default()
+    };
     let (estimated, report) =
         relax(&input, &stock_model(), &options, &mut |_: RelaxEvent| {}).expect("estimation runs");
     assert!(report.resets >= 1);
@@ -127,7 +126,10 @@ fn the_estimation_keeps_rest_lengths_within_their_bound() {
     for (a, b) in after.iter().zip(before) {
         assert!((a / b - 1.0).abs() <= 0.2 + 1e-12, "rest length {a} vs input {b}");
     }
-    assert!(after.iter().zip(before).any(|(a, b)| (a / b - 1.0).abs() > 1e-3), "the rest shape was estimated");
+    assert!(
+        after.iter().zip(before).any(|(a, b)| (a / b - 1.0).abs() > 1e-3),
+        "the rest shape was estimated"
+    );
     let tile = RveModel::new(&estimated, &stock_model()).expect("estimated tile");
     let (_, _, _) = solve(&tile, "sx=0");
 }
@@ -159,4 +161,3 @@ fn the_biphasic_yarn_stiffens_past_its_onset_strain() {
     let (early, late) = (energy(0.0), energy(10.0));
     assert!(early > 2.0 * late, "early onset {early} vs late onset {late} J/m²");
 }
-

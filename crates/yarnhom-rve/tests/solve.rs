@@ -104,8 +104,6 @@ fn stockinette_curls_and_its_two_edges_curl_opposite_ways() {
     );
 }
 
-
-
 #[test]
 fn collision_detection_steps_reach_the_same_stretched_equilibrium() {
     // Additive CCD in place of the step limit (A.2.3) changes the path, not the equilibrium.
