@@ -12,6 +12,15 @@ use yarnhom_artifacts::{AnyArtifact, Header, Pattern, hdf5, pyp};
 const PATTERNS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../shared/data/hylc-patterns");
 const TOOL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../tools/h5py_read_pattern.py");
 
+/// One test at a time in this binary: a Python child forked while another test's thread holds an
+/// HDF5 file open inherits that descriptor (HDF5 opens files without close-on-exec) and with it
+/// the file's lock, so an import racing the child failed with "unable to lock file".
+static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn serialized() -> std::sync::MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 /// Every published pattern, parsed, with the header an import would give it.
 fn published() -> Vec<(String, Header, Pattern)> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(PATTERNS)
@@ -62,6 +71,7 @@ fn export(dir: &Path, file: &str, header: &Header, pattern: &Pattern) -> PathBuf
 
 #[test]
 fn published_patterns_round_trip_exactly() {
+    let _guard = serialized();
     let dir = tempfile::tempdir().unwrap();
     for (name, header, pattern) in published() {
         for (variant, p) in variants(&pattern) {
@@ -136,6 +146,7 @@ fn floats(v: &serde_json::Value) -> Vec<f64> {
 
 #[test]
 fn h5py_reads_published_patterns() {
+    let _guard = serialized();
     if let Err(reason) = h5py_available() {
         println!("SKIPPED: h5py cannot be installed: {reason}");
         return;
@@ -165,6 +176,7 @@ fn h5py_reads_published_patterns() {
 /// does yarnhom's importer.
 #[test]
 fn h5py_and_importer_refuse_a_corrupted_export() {
+    let _guard = serialized();
     if let Err(reason) = h5py_available() {
         println!("SKIPPED: h5py cannot be installed: {reason}");
         return;

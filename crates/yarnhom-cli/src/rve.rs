@@ -111,6 +111,24 @@ fn load_model(spec: &str) -> anyhow::Result<(YarnModel, Option<yarnhom_artifacts
     }
 }
 
+/// The pattern and yarn model a tile command works on, and the inputs they name in provenance.
+fn load_pattern_and_model(
+    path: &std::path::Path,
+    model_spec: &str,
+) -> anyhow::Result<(yarnhom_artifacts::Pattern, YarnModel, Vec<yarnhom_artifacts::InputRef>)> {
+    let loaded = inputs::load(path, None)?;
+    let input = yarnhom_artifacts::InputRef {
+        kind: "pattern".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: path.display().to_string(),
+    };
+    let AnyArtifact::Pattern(pattern) = loaded.artifact else {
+        anyhow::bail!("{}: holds a '{}', not a pattern", path.display(), loaded.artifact.kind())
+    };
+    let (model, model_input) = load_model(model_spec)?;
+    Ok((pattern, model, std::iter::once(input).chain(model_input).collect()))
+}
+
 fn stop_reason(reason: StopReason) -> &'static str {
     match reason {
         StopReason::Converged => "converged",
@@ -122,11 +140,8 @@ fn stop_reason(reason: StopReason) -> &'static str {
 
 fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     let strain: MacroStrain = args.strain.parse()?;
-    let loaded = inputs::load(&args.pattern, None)?;
-    let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
-        anyhow::bail!("{}: holds a '{}', not a pattern", args.pattern.display(), loaded.artifact.kind())
-    };
-    let (model, model_input) = load_model(&args.model)?;
+    let (pattern, model, inputs_list) = load_pattern_and_model(&args.pattern, &args.model)?;
+    let pattern = &pattern;
     let tile = RveModel::new(pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
     let step_control = match args.ccd {
         Some(d) if !(d > 0.0 && d < 2.0) => {
@@ -174,12 +189,6 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         edge_twist_rad: (0..tile.vertices as u32).map(|v| state.g[tile.twist_dof(v)]).collect(),
     };
     let output = args.output.unwrap_or_else(|| format!("{}.rvesolve.yh", base_name(&args.pattern)).into());
-    let mut inputs_list = vec![yarnhom_artifacts::InputRef {
-        kind: "pattern".into(),
-        content_hash: loaded.header.content_hash.clone(),
-        path: args.pattern.display().to_string(),
-    }];
-    inputs_list.extend(model_input);
     container::write(&output, &result, &provenance("rve solve", inputs_list))?;
     println!("{}", result.summary());
     eprintln!("wrote {}", output.display());
@@ -192,11 +201,8 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
 }
 
 fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
-    let loaded = inputs::load(&args.pattern, None)?;
-    let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
-        anyhow::bail!("{}: holds a '{}', not a pattern", args.pattern.display(), loaded.artifact.kind())
-    };
-    let (model, model_input) = load_model(&args.model)?;
+    let (pattern, model, inputs_list) = load_pattern_and_model(&args.pattern, &args.model)?;
+    let pattern = &pattern;
     let method = match args.estimation {
         Some(bound) if !(bound > 0.0 && bound < 1.0) => {
             anyhow::bail!("--estimation {bound}: the rest-length bound must lie strictly between 0 and 1")
@@ -246,12 +252,6 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
     }
     let output =
         args.output.unwrap_or_else(|| format!("{}.relaxed.pattern.yh", base_name(&args.pattern)).into());
-    let mut inputs_list = vec![yarnhom_artifacts::InputRef {
-        kind: "pattern".into(),
-        content_hash: loaded.header.content_hash.clone(),
-        path: args.pattern.display().to_string(),
-    }];
-    inputs_list.extend(model_input);
     container::write(&output, &relaxed, &provenance("rve relax", inputs_list))?;
     let [sx, sa, sy] = report.residual_stress_j_m2;
     println!(

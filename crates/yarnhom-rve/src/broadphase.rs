@@ -99,27 +99,58 @@ fn bounds(boxes: &[Aabb]) -> Aabb {
 /// directly, which bounds the cells per box (a degenerate step can produce huge swept boxes).
 const WIDE_CELLS: f64 = 4.0;
 
-/// A uniform grid over boxes, as the sorted list of `(cell, box)` for every cell a box touches.
-/// The cell size is the boxes' mean largest side, so a typical box touches at most 2 cells per
-/// axis.
+/// Buckets per axis at most: cells beyond wrap around (a spatial hash), so that boxes strewn far
+/// apart cost no memory; cells sharing a bucket only add candidates, which the exact test drops.
+const MAX_BUCKETS: f64 = 32.0;
+
+/// A uniform grid over boxes, hashed into a table of buckets (cell coordinates modulo the table
+/// size) stored as one list: bucket `k` holds `items[starts[k]..starts[k + 1]]`, each box in
+/// the buckets of every cell it touches. The cell size is the boxes' mean largest side, so a
+/// typical box touches at most 2 cells per axis; the table spans the boxes' extent.
 struct Grid<'a> {
     boxes: &'a [Aabb],
     cell: f64,
-    entries: Vec<([i64; 3], usize)>,
+    buckets: [i64; 3],
+    starts: Vec<usize>,
+    items: Vec<usize>,
     wide: Vec<usize>,
 }
 
 impl<'a> Grid<'a> {
     fn new(boxes: &'a [Aabb]) -> Self {
         let cell = boxes.iter().map(Aabb::largest_side).sum::<f64>() / boxes.len() as f64;
-        let mut grid = Grid { boxes, cell, entries: Vec::new(), wide: Vec::new() };
-        for (i, b) in boxes.iter().enumerate() {
-            match grid.cells(b) {
-                Some((lo, hi)) => grid.entries.extend(cells_between(lo, hi).map(|c| (c, i))),
+        let extent = bounds(boxes);
+        let buckets = [0, 1, 2].map(|k| {
+            let cells = ((extent.hi[k] - extent.lo[k]) / cell).floor() + 1.0;
+            if cells.is_finite() { cells.clamp(1.0, MAX_BUCKETS) as i64 } else { MAX_BUCKETS as i64 }
+        });
+        let size = (buckets[0] * buckets[1] * buckets[2]) as usize;
+        let mut grid =
+            Grid { boxes, cell, buckets, starts: vec![0; size + 1], items: Vec::new(), wide: Vec::new() };
+        let ranges: Vec<Option<([i64; 3], [i64; 3])>> = boxes.iter().map(|b| grid.cells(b)).collect();
+        for &(lo, hi) in ranges.iter().flatten() {
+            for c in cells_between(lo, hi) {
+                let k = grid.bucket(c);
+                grid.starts[k + 1] += 1;
+            }
+        }
+        for k in 0..size {
+            grid.starts[k + 1] += grid.starts[k];
+        }
+        let mut next = grid.starts.clone();
+        grid.items = vec![0; grid.starts[size]];
+        for (i, range) in ranges.iter().enumerate() {
+            match *range {
+                Some((lo, hi)) => {
+                    for c in cells_between(lo, hi) {
+                        let k = grid.bucket(c);
+                        grid.items[next[k]] = i;
+                        next[k] += 1;
+                    }
+                }
                 None => grid.wide.push(i),
             }
         }
-        grid.entries.sort_unstable();
         grid
     }
 
@@ -132,19 +163,27 @@ impl<'a> Grid<'a> {
         narrow.then(|| (lo.map(|x| x as i64).into(), hi.map(|x| x as i64).into()))
     }
 
+    /// The bucket of a cell.
+    fn bucket(&self, c: [i64; 3]) -> usize {
+        let [nx, ny, nz] = self.buckets;
+        ((c[0].rem_euclid(nx) * ny + c[1].rem_euclid(ny)) * nz + c[2].rem_euclid(nz)) as usize
+    }
+
     /// The boxes overlapping `query` into `hits`, each once, in ascending order.
     fn overlapping(&self, query: &Aabb, hits: &mut Vec<usize>) {
         hits.clear();
+        let overlapping = |i: &usize| self.boxes[*i].overlaps(query);
         match self.cells(query) {
             Some((lo, hi)) => {
-                for cell in cells_between(lo, hi) {
-                    let start = self.entries.partition_point(|e| e.0 < cell);
-                    let in_cell = self.entries[start..].iter().take_while(|e| e.0 == cell);
-                    hits.extend(in_cell.map(|e| e.1).filter(|&i| self.boxes[i].overlaps(query)));
+                for c in cells_between(lo, hi) {
+                    let k = self.bucket(c);
+                    hits.extend(
+                        self.items[self.starts[k]..self.starts[k + 1]].iter().filter(|i| overlapping(i)),
+                    );
                 }
-                hits.extend(self.wide.iter().copied().filter(|&i| self.boxes[i].overlaps(query)));
+                hits.extend(self.wide.iter().filter(|i| overlapping(i)));
             }
-            None => hits.extend((0..self.boxes.len()).filter(|&i| self.boxes[i].overlaps(query))),
+            None => hits.extend((0..self.boxes.len()).filter(overlapping)),
         }
         hits.sort_unstable();
         hits.dedup();
@@ -266,8 +305,23 @@ mod tests {
         // Zero-size boxes give a zero cell: all are tested directly.
         let points = [Aabb::around_segment(&Vector3::zeros(), &Vector3::zeros(), 0.0); 2];
         let degenerate = Grid::new(&points);
-        assert!(degenerate.entries.is_empty());
+        assert!(degenerate.items.is_empty());
         degenerate.overlapping(&unit(0.0), &mut hits);
         assert_eq!(hits, [0, 1]);
+    }
+
+    #[test]
+    fn boxes_far_apart_share_buckets_without_false_hits() {
+        let unit = |x: f64| Aabb { lo: Vector3::new(x, 0.0, 0.0), hi: Vector3::new(x + 1.0, 1.0, 1.0) };
+        // 1e6 cells apart: a multiple of the 32 buckets, so both fall in the same ones.
+        let boxes = [unit(0.0), unit(1e6)];
+        let grid = Grid::new(&boxes);
+        assert_eq!(grid.buckets[0], 32);
+        assert_eq!(grid.items.len(), 2 * 2 * 2 * 2);
+        let mut hits = Vec::new();
+        grid.overlapping(&unit(0.5), &mut hits);
+        assert_eq!(hits, [0]);
+        grid.overlapping(&unit(1e6 - 0.5), &mut hits);
+        assert_eq!(hits, [1]);
     }
 }
