@@ -5,9 +5,12 @@
 //! lists every compared field with its largest and RMS difference, so a report says *where*
 //! two files differ, not only *whether*.
 
+use std::collections::HashMap;
+
 use serde::Serialize;
 
 use crate::AnyArtifact;
+use crate::grid::{Grid, GridSample, GridTerm};
 use crate::pattern::Pattern;
 use crate::rvesolve::RveSolve;
 use crate::yarnmodel::YarnModel;
@@ -126,6 +129,26 @@ impl Diff {
         let wrap = |v: &[f64]| v.iter().map(|&x| [x]).collect::<Vec<[f64; 1]>>();
         self.rows(field, &wrap(a), &wrap(b), tol);
     }
+
+    /// Compare rows of matched grid samples; `worst_index` becomes the row of the worst sample in
+    /// the first grid's `samples`, and a field outside tolerance gets a note naming that sample.
+    fn sample_rows<const N: usize>(
+        &mut self,
+        field: &str,
+        matched: &[(&GridSample, [[f64; N]; 2])],
+        first: &Grid,
+        tol: Tolerance,
+    ) {
+        let (a, b): (Vec<_>, Vec<_>) = matched.iter().map(|(_, [x, y])| (*x, *y)).unzip();
+        self.rows(field, &a, &b, tol);
+        let Some(f) = self.fields.last_mut() else { return };
+        let Some((worst, _)) = matched.get(f.worst_index) else { return };
+        f.worst_index = first.samples.iter().position(|s| s.key() == worst.key()).unwrap_or(f.worst_index);
+        if f.outside > 0 {
+            let note = format!("{field}: largest difference at {}", worst.describe());
+            self.notes.push(note);
+        }
+    }
 }
 
 /// Compare two artifacts.
@@ -134,6 +157,7 @@ pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
         (AnyArtifact::Pattern(a), AnyArtifact::Pattern(b)) => diff_patterns(a, b, tol),
         (AnyArtifact::YarnModel(a), AnyArtifact::YarnModel(b)) => diff_yarn_models(a, b, tol),
         (AnyArtifact::RveSolve(a), AnyArtifact::RveSolve(b)) => diff_rve_solves(a, b, tol),
+        (AnyArtifact::Grid(a), AnyArtifact::Grid(b)) => diff_grids(a, b, tol),
         _ => {
             let mut d = Diff::new(a.kind());
             d.structural.push(format!("kinds differ: {} vs {}", a.kind(), b.kind()));
@@ -237,4 +261,61 @@ pub fn diff_rve_solves(a: &RveSolve, b: &RveSolve, tol: Tolerance) -> Diff {
     d.rows("positions_m", &a.positions_m, &b.positions_m, tol);
     d.values("edge_twist_rad", &a.edge_twist_rad, &b.edge_twist_rad, tol);
     d
+}
+
+/// Compare two grids: the sampling plan exactly, then the outcome, energy and stress of the
+/// samples both hold, matched by `(term, index)`. A sample field's `worst_index` is the row in
+/// the first grid's `samples`; samples in only one grid are structural differences.
+pub fn diff_grids(a: &Grid, b: &Grid, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("grid");
+    for (what, x, y) in [("pattern", &a.pattern, &b.pattern), ("model", &a.model, &b.model)] {
+        if x != y {
+            d.notes.push(format!("{what}s differ: '{x}' vs '{y}'"));
+        }
+    }
+    if a.shard != b.shard {
+        d.notes.push(format!("shards differ: {:?} vs {:?}", a.shard, b.shard));
+    }
+    if a.terms != b.terms {
+        let names = |g: &Grid| {
+            let sizes =
+                |t: &GridTerm| t.values.iter().map(|v| v.len().to_string()).collect::<Vec<_>>().join("x");
+            g.terms.iter().map(|t| format!("{} ({})", t.name(), sizes(t))).collect::<Vec<_>>().join("; ")
+        };
+        d.structural.push(format!("terms: [{}] vs [{}]", names(a), names(b)));
+        return d;
+    }
+    let pairs = matched_samples(a, b, &mut d);
+    let energies: Vec<_> = pairs
+        .iter()
+        .filter_map(|(x, y)| Some((*x, [[x.energy_density_j_m2?], [y.energy_density_j_m2?]])))
+        .collect();
+    d.sample_rows("samples.energy_density_j_m2", &energies, a, tol);
+    let stresses: Vec<_> = pairs.iter().filter_map(|(x, y)| Some((*x, [x.stress?, y.stress?]))).collect();
+    d.sample_rows("samples.stress", &stresses, a, tol);
+    d
+}
+
+/// The samples both grids hold, matched by `(term, index)`; samples in one grid only, and
+/// matched samples whose outcome or stress presence differ, are recorded as structural.
+fn matched_samples<'a>(a: &'a Grid, b: &'a Grid, d: &mut Diff) -> Vec<(&'a GridSample, &'a GridSample)> {
+    let in_b: HashMap<_, _> = b.samples.iter().map(|s| (s.key(), s)).collect();
+    let pairs: Vec<_> = a.samples.iter().filter_map(|s| Some((s, *in_b.get(&s.key())?))).collect();
+    let in_a: HashMap<_, _> = a.samples.iter().map(|s| (s.key(), s)).collect();
+    let only_a: Vec<_> = a.samples.iter().filter(|s| !in_b.contains_key(&s.key())).collect();
+    let only_b: Vec<_> = b.samples.iter().filter(|s| !in_a.contains_key(&s.key())).collect();
+    let outcome: Vec<_> = pairs.iter().filter(|(x, y)| x.converged != y.converged).map(|p| p.0).collect();
+    let stress: Vec<_> =
+        pairs.iter().filter(|(x, y)| x.stress.is_some() != y.stress.is_some()).map(|p| p.0).collect();
+    for (what, samples) in [
+        ("only in the first file", only_a),
+        ("only in the second file", only_b),
+        ("converged in one file only", outcome),
+        ("with a stress in one file only", stress),
+    ] {
+        if let Some(s) = samples.first() {
+            d.structural.push(format!("{} samples {what}, e.g. {}", samples.len(), s.describe()));
+        }
+    }
+    pairs
 }

@@ -2,8 +2,8 @@
 //!
 //! `yarnhom convert --to hdf5` writes an artifact as an HDF5 file that any HDF5 reader (h5py,
 //! MATLAB, HDFView, ...) can open; [`import`] reads such a file back into the exact artifact. Only
-//! kinds made of arrays have a layout, today `pattern`; a `yarnmodel` (a handful of scalars) is
-//! refused with [`Error::Unrepresentable`]: use JSON for it.
+//! kinds made of arrays have a layout, today `pattern` and `grid`; a `yarnmodel` (a handful of
+//! scalars) is refused with [`Error::Unrepresentable`]: use JSON for it.
 //!
 //! # Layout of a `pattern` (schema version 1)
 //!
@@ -44,6 +44,29 @@
 //! The group `/rest` exists exactly when the pattern has a rest state. Per-edge rows are indexed
 //! by the edge's source vertex, as in [`Pattern`]; `edge_offsets` rows follow `/yarns/vertices`.
 //!
+//! # Layout of a `grid` (schema version 1)
+//!
+//! `n` samples, `T` terms, `V` vertices per sample (with geometry). Root attributes: those of a
+//! pattern from `yarnhom_kind` (`grid`) to `inputs`, then `pattern` and `model` (strings), and
+//! `shard_index`, `shard_count` (u32) for a partial grid only. Datasets (with `units` and
+//! `description`):
+//!
+//! | dataset | type, shape | units | meaning |
+//! |---|---|---|---|
+//! | `/axes/sx`, `/axes/sa`, `/axes/sy`, `/axes/kx`, `/axes/ky` | f64 `[len]` | 1 (1/m for kx, ky) | sampled values of each strain axis |
+//! | `/terms/axes` | i32 `[T, 2]` | 1 | axis indices of each term; the second is -1 for a 1D term |
+//! | `/samples/term` | u32 `[n]` | 1 | term of each sample |
+//! | `/samples/index` | u32 `[n, 2]` | 1 | indices into the term's axes' values (second 0 for 1D) |
+//! | `/samples/strain` | f64 `[n, 5]` | 1, 1/m | strain, columns sx, sa, sy, kx, ky |
+//! | `/samples/converged` | u8 `[n]` | 1 | 1 if converged, else 0 |
+//! | `/samples/stop_reason` | string `[n]` | 1 | variable-length UTF-8, why the solver stopped |
+//! | `/samples/energy_density_j_m2` | f64 `[n]` | J/m² | energy density (3.22), NaN where not converged |
+//! | `/samples/stress` | f64 `[n, 5]` | J/m², J/m | stress (3.23c), NaN rows where absent |
+//! | `/samples/iterations` | u32 `[n]` | 1 | Newton iterations |
+//! | `/samples/seconds` | f64 `[n]` | s | wall time |
+//! | `/samples/positions_m` | f64 `[n, V, 3]` | m | equilibrium vertices (optional) |
+//! | `/samples/edge_twist_rad` | f64 `[n, V]` | rad | equilibrium edge twists (with positions) |
+//!
 //! # Choices
 //!
 //! - No chunking and no compression: a pattern is one periodic tile, a few hundred vertices in
@@ -67,8 +90,11 @@ use ::hdf5::{Dataset, File, Group, H5Type, Location};
 
 use crate::container::{self, Header, InputRef, Producer};
 use crate::error::{Error, Result, ValidationError};
+use crate::grid::Grid;
 use crate::pattern::{Fabric, Pattern, RestState, Yarn};
 use crate::{AnyArtifact, Artifact};
+
+mod grid;
 
 const FORMAT: &str = "hdf5";
 
@@ -143,7 +169,8 @@ fn h5(context: impl std::fmt::Display, e: ::hdf5::Error) -> Error {
 /// [`Error::Unrepresentable`]. Errors name the file.
 pub fn export(path: &Path, header: &Header, artifact: &AnyArtifact) -> Result<()> {
     match artifact {
-        AnyArtifact::Pattern(p) => export_pattern(path, header, p),
+        AnyArtifact::Pattern(p) => export_as(path, header, p, write_pattern),
+        AnyArtifact::Grid(g) => export_as(path, header, g, grid::write_grid),
         AnyArtifact::YarnModel(_) => Err(Error::Unrepresentable {
             format: FORMAT,
             message: "a yarnmodel holds no arrays, so it has no HDF5 layout; use `--to json`".into(),
@@ -166,9 +193,16 @@ pub fn import(path: &Path) -> Result<(Header, AnyArtifact)> {
 // ---------------------------------------------------------------------------------------------
 // Export
 
-fn export_pattern(path: &Path, header: &Header, p: &Pattern) -> Result<()> {
-    p.validate().map_err(|problem| Error::Invalid { kind: Pattern::KIND, problem })?;
-    let content_hash = container::content_hash(&container::payload_of(p)?);
+/// Validate `artifact`, then write it atomically: the root attributes every export carries,
+/// then the kind's own attributes and datasets by `write`.
+fn export_as<T: Artifact>(
+    path: &Path,
+    header: &Header,
+    artifact: &T,
+    write: fn(&Group, &T) -> Result<()>,
+) -> Result<()> {
+    artifact.validate().map_err(|problem| Error::Invalid { kind: T::KIND, problem })?;
+    let content_hash = container::content_hash(&container::payload_of(artifact)?);
     let inputs = serde_json::to_string(&header.inputs)
         .map_err(|e| Error::Encode { what: "inputs", message: e.to_string() })?;
 
@@ -177,19 +211,24 @@ fn export_pattern(path: &Path, header: &Header, p: &Pattern) -> Result<()> {
             .with_fcpl(|fcpl| fcpl.obj_track_times(false))
             .create(tmp)
             .map_err(|e| h5("cannot create the HDF5 file", e))?;
-        write_pattern(&file, header, p, &content_hash, &inputs)?;
+        write_header::<T>(&file, header, &content_hash, &inputs)?;
+        write(&file, artifact)?;
         file.close().map_err(|e| h5("cannot close the HDF5 file", e))
     })
 }
 
-fn write_pattern(root: &Group, header: &Header, p: &Pattern, content_hash: &str, inputs: &str) -> Result<()> {
-    write_str_attr(root, KIND_ATTR, Pattern::KIND)?;
-    write_u32_attr(root, "schema_version", Pattern::SCHEMA_VERSION)?;
+/// The root attributes of every export: kind, schema version, content hash, provenance.
+fn write_header<T: Artifact>(root: &Group, header: &Header, content_hash: &str, inputs: &str) -> Result<()> {
+    write_str_attr(root, KIND_ATTR, T::KIND)?;
+    write_u32_attr(root, "schema_version", T::SCHEMA_VERSION)?;
     write_str_attr(root, "content_hash", content_hash)?;
     write_str_attr(root, "producer_name", &header.producer.name)?;
     write_str_attr(root, "producer_version", &header.producer.version)?;
     write_str_attr(root, "created_utc", &header.created_utc)?;
-    write_str_attr(root, "inputs", inputs)?;
+    write_str_attr(root, "inputs", inputs)
+}
+
+fn write_pattern(root: &Group, p: &Pattern) -> Result<()> {
     write_str_attr(root, "name", &p.name)?;
     write_str_attr(root, "fabric", &p.fabric.to_string())?;
     write_str_attr(root, "origin", &p.origin)?;
@@ -248,11 +287,13 @@ fn write_dataset<T: H5Type>(root: &Group, spec: &Spec, shape: &[usize], data: &[
     write_str_attr(&ds, "description", spec.description)
 }
 
+/// A string as HDF5 variable-length UTF-8; `what` names it if it cannot be one.
+fn varlen(what: &str, value: &str) -> Result<VarLenUnicode> {
+    value.parse().map_err(|e| Error::Unrepresentable { format: FORMAT, message: format!("{what}: {e}") })
+}
+
 fn write_str_attr(loc: &Location, name: &str, value: &str) -> Result<()> {
-    let value: VarLenUnicode = value.parse().map_err(|e| Error::Unrepresentable {
-        format: FORMAT,
-        message: format!("attribute '{name}': {e}"),
-    })?;
+    let value = varlen(&format!("attribute '{name}'"), value)?;
     loc.new_attr::<VarLenUnicode>()
         .create(name)
         .and_then(|a| a.write_scalar(&value))
@@ -282,8 +323,12 @@ fn import_any(path: &Path) -> Result<(Header, AnyArtifact)> {
     let kind = read_str_attr(&file, KIND_ATTR)?;
     match kind.as_str() {
         k if k == Pattern::KIND => {
-            let (header, pattern) = read_pattern(&file)?;
+            let (header, pattern) = read_as(&file, read_pattern)?;
             Ok((header, AnyArtifact::Pattern(pattern)))
+        }
+        k if k == Grid::KIND => {
+            let (header, grid) = read_as(&file, grid::read_grid)?;
+            Ok((header, AnyArtifact::Grid(grid)))
         }
         k if crate::KINDS.contains(&k) => Err(Error::Hdf5(format!(
             "root attribute '{KIND_ATTR}' names kind '{k}', which has no HDF5 layout"
@@ -292,21 +337,23 @@ fn import_any(path: &Path) -> Result<(Header, AnyArtifact)> {
     }
 }
 
-fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
+/// Read an export of kind `T`: check the schema version, read the provenance, the artifact (by
+/// `read`), validate it and check its content hash.
+fn read_as<T: Artifact>(root: &Group, read: fn(&Group) -> Result<T>) -> Result<(Header, T)> {
     let schema_version = read_u32_attr(root, "schema_version")?;
-    match schema_version.cmp(&Pattern::SCHEMA_VERSION) {
+    match schema_version.cmp(&T::SCHEMA_VERSION) {
         std::cmp::Ordering::Greater => {
             return Err(Error::NewerSchema {
-                kind: Pattern::KIND.into(),
+                kind: T::KIND.into(),
                 found: schema_version,
-                supported: Pattern::SCHEMA_VERSION,
+                supported: T::SCHEMA_VERSION,
             });
         }
         std::cmp::Ordering::Less => {
             return Err(Error::NoMigration {
-                kind: Pattern::KIND.into(),
+                kind: T::KIND.into(),
                 found: schema_version,
-                supported: Pattern::SCHEMA_VERSION,
+                supported: T::SCHEMA_VERSION,
             });
         }
         std::cmp::Ordering::Equal => {}
@@ -319,6 +366,26 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
     let created_utc = read_str_attr(root, "created_utc")?;
     let inputs: Vec<InputRef> = serde_json::from_str(&read_str_attr(root, "inputs")?)
         .map_err(|e| Error::Hdf5(format!("root attribute 'inputs' is not a JSON list of inputs: {e}")))?;
+    let artifact = read(root)?;
+    artifact.validate().map_err(|problem| Error::Invalid { kind: T::KIND, problem })?;
+    let payload = container::payload_of(&artifact)?;
+    let computed = container::content_hash(&payload);
+    if computed != stored_hash {
+        return Err(Error::ContentHashMismatch { stored: stored_hash, computed });
+    }
+    let header = Header {
+        kind: T::KIND.into(),
+        schema_version,
+        producer,
+        created_utc,
+        inputs,
+        content_hash: stored_hash,
+        payload_bytes: payload.len() as u64,
+    };
+    Ok((header, artifact))
+}
+
+fn read_pattern(root: &Group) -> Result<Pattern> {
     let name = read_str_attr(root, "name")?;
     let fabric = match read_str_attr(root, "fabric")?.as_str() {
         "knit" => Fabric::Knit,
@@ -364,7 +431,7 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
         None
     };
 
-    let pattern = Pattern {
+    Ok(Pattern {
         name,
         fabric,
         period_m: [period[0], period[1]],
@@ -373,23 +440,7 @@ fn read_pattern(root: &Group) -> Result<(Header, Pattern)> {
         yarns,
         rest,
         origin,
-    };
-    pattern.validate().map_err(|problem| Error::Invalid { kind: Pattern::KIND, problem })?;
-    let payload = container::payload_of(&pattern)?;
-    let computed = container::content_hash(&payload);
-    if computed != stored_hash {
-        return Err(Error::ContentHashMismatch { stored: stored_hash, computed });
-    }
-    let header = Header {
-        kind: Pattern::KIND.into(),
-        schema_version,
-        producer,
-        created_utc,
-        inputs,
-        content_hash: stored_hash,
-        payload_bytes: payload.len() as u64,
-    };
-    Ok((header, pattern))
+    })
 }
 
 /// The row ranges of a CSR row pointer over `n` rows, checked.

@@ -3,7 +3,7 @@
 //! - [`container`]: the versioned `.yh` framing shared by every kind (magic, header, zstd
 //!   msgpack payload, checksum), atomic writes, migrations of older schema versions.
 //! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`),
-//!   [`rvesolve::RveSolve`] (`rvesolve`).
+//!   [`rvesolve::RveSolve`] (`rvesolve`), [`grid::Grid`] (`grid`).
 //! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
@@ -13,6 +13,7 @@ pub mod check;
 pub mod container;
 pub mod diff;
 pub mod error;
+pub mod grid;
 #[cfg(feature = "hdf5")]
 pub mod hdf5;
 pub mod pattern;
@@ -25,6 +26,7 @@ use serde::{Deserialize, Serialize, de::DeserializeOwned};
 
 pub use container::{Header, InputRef, Producer, Provenance, RawArtifact};
 pub use error::{Error, Result, ValidationError};
+pub use grid::{Grid, GridSample, GridShard, GridTerm, MergeError};
 pub use pattern::{Fabric, Pattern, RestState, Yarn};
 pub use rvesolve::{RveSolve, StrainSample};
 pub use yarnmodel::{YarnMechanics, YarnModel};
@@ -161,10 +163,22 @@ impl Artifact for RveSolve {
     }
 }
 
+impl Artifact for Grid {
+    const KIND: &'static str = "grid";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), ValidationError> {
+        Grid::validate(self)
+    }
+    fn summary(&self) -> String {
+        Grid::summary(self)
+    }
+}
+
 artifact_kinds! {
     Pattern => Pattern,
     YarnModel => YarnModel,
     RveSolve => RveSolve,
+    Grid => Grid,
 }
 
 impl AnyArtifact {

@@ -194,11 +194,23 @@ proptest! {
     }
 
     #[test]
-    fn every_kind_round_trips_through_json(p in common::pattern(), m in common::yarn_model(), r in common::rve_solve()) {
+    fn grid_round_trips_through_the_container(g in common::grid()) {
+        let bytes = encode(&g, &Provenance::default()).expect("encode");
+        prop_assert_eq!(decode::<yarnhom_artifacts::Grid>(&bytes).expect("decode").1, g);
+    }
+
+    #[test]
+    fn every_kind_round_trips_through_json(
+        p in common::pattern(),
+        m in common::yarn_model(),
+        r in common::rve_solve(),
+        g in common::grid(),
+    ) {
         for a in [
             yarnhom_artifacts::AnyArtifact::Pattern(p),
             yarnhom_artifacts::AnyArtifact::YarnModel(m),
             yarnhom_artifacts::AnyArtifact::RveSolve(r),
+            yarnhom_artifacts::AnyArtifact::Grid(g),
         ] {
             let bytes = a.encode(&Provenance::default()).expect("encode");
             let raw = container::decode_raw(&bytes).expect("raw");

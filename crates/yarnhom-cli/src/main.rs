@@ -6,11 +6,13 @@
 
 mod convert;
 mod diff;
+mod grid;
 mod inputs;
 mod inspect;
 mod model;
 mod pattern;
 mod rve;
+mod sample;
 mod schema;
 
 use std::process::ExitCode;
@@ -40,6 +42,9 @@ enum Command {
     /// The periodic yarn tile (thesis Ch. 3): equilibrium, homogenized energy and stress.
     #[command(subcommand)]
     Rve(rve::RveCommand),
+    /// Sampled energy grids (thesis App. A.3.1): merge the shards of a sampling run.
+    #[command(subcommand)]
+    Grid(grid::GridCommand),
     /// Describe an artifact: kind, schema version, provenance and a human summary.
     Inspect(inspect::InspectArgs),
     /// Convert an artifact between `.yh`, JSON, HDF5 and `.pyp`.
@@ -61,6 +66,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Pattern(cmd) => pattern::run(cmd),
         Command::Model(cmd) => model::run(cmd),
         Command::Rve(cmd) => rve::run(cmd),
+        Command::Grid(cmd) => grid::run(cmd),
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Schema(args) => schema::run(args),

@@ -31,6 +31,16 @@ pub enum RveCommand {
     /// generated patterns (no rest state yet) and on imported ones. Exit status 0 on success,
     /// 2 when a stage fails (the message names the stage).
     Relax(RelaxArgs),
+    /// Sample the homogenized energy (and stress) over the plan of App. A.3.1 into a `grid`
+    /// artifact: five 1D terms of N1D samples and nine 2D terms of N2D x N2D (all pairs of
+    /// sx, sa, sy, kx, ky but kx-ky), non-uniformly spaced, each sweep line warm-started outward
+    /// from zero strain, lines in parallel on all cores (RAYON_NUM_THREADS to limit).
+    ///
+    /// Resumable: every finished line is appended to OUTPUT.checkpoint, and a rerun with the
+    /// same arguments continues from it. `--shard K/N` computes one of N disjoint sets of lines
+    /// (for a Slurm job array or a Kubernetes Indexed Job: tools/slurm-sample.sh,
+    /// tools/k8s-sample.yaml); `yarnhom grid merge` joins the shards bit-identically.
+    Sample(crate::sample::SampleArgs),
 }
 
 #[derive(Debug, Args)]
@@ -91,6 +101,7 @@ pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
     match cmd {
         RveCommand::Solve(args) => solve(args),
         RveCommand::Relax(args) => relax(args),
+        RveCommand::Sample(args) => crate::sample::run(args),
     }
 }
 
@@ -112,7 +123,7 @@ fn load_model(spec: &str) -> anyhow::Result<(YarnModel, Option<yarnhom_artifacts
 }
 
 /// The pattern and yarn model a tile command works on, and the inputs they name in provenance.
-fn load_pattern_and_model(
+pub(crate) fn load_pattern_and_model(
     path: &std::path::Path,
     model_spec: &str,
 ) -> anyhow::Result<(yarnhom_artifacts::Pattern, YarnModel, Vec<yarnhom_artifacts::InputRef>)> {
@@ -129,7 +140,7 @@ fn load_pattern_and_model(
     Ok((pattern, model, std::iter::once(input).chain(model_input).collect()))
 }
 
-fn stop_reason(reason: StopReason) -> &'static str {
+pub(crate) fn stop_reason(reason: StopReason) -> &'static str {
     match reason {
         StopReason::Converged => "converged",
         StopReason::IterationLimit => "iteration_limit",

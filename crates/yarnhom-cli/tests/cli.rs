@@ -205,6 +205,8 @@ fn every_command_explains_itself() {
         &["rve"],
         &["rve", "solve"],
         &["rve", "relax"],
+        &["rve", "sample"],
+        &["grid", "merge"],
     ];
     for cmd in commands {
         let mut args = cmd.to_vec();
@@ -321,4 +323,73 @@ fn rve_relax_gives_a_generated_pattern_a_rest_state_without_in_plane_stress() {
         dir.path(),
     );
     assert!(text.contains("converged after"), "{text}");
+}
+
+#[test]
+fn rve_sample_shards_merge_into_the_unsharded_grid_and_a_killed_run_resumes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tiny = format!("{DATA}/stocktiniest.pyp");
+    let args = |extra: &[&str], out: &str| -> Vec<String> {
+        let mut a: Vec<String> =
+            ["rve", "sample", &tiny, "--model", "table4.1:stock-small", "--n1d", "5", "--n2d", "3"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+        a.extend(extra.iter().map(|s| s.to_string()));
+        a.extend(["-o".to_string(), out.to_string()]);
+        a
+    };
+    let run = |a: Vec<String>| ok(&a.iter().map(String::as_str).collect::<Vec<_>>(), dir.path());
+    let whole = dir.path().join("whole.grid.yh");
+    let text = run(args(&[], whole.to_str().expect("utf8")));
+    assert!(text.contains("complete"), "{text}");
+    let mut shards = Vec::new();
+    for k in 0..3 {
+        let shard = dir.path().join(format!("shard-{k}.grid.yh"));
+        run(args(&["--shard", &format!("{k}/3")], shard.to_str().expect("utf8")));
+        shards.push(shard.to_str().expect("utf8").to_string());
+    }
+    let merged = dir.path().join("merged.grid.yh");
+    let mut merge: Vec<&str> = vec!["grid", "merge"];
+    merge.extend(shards.iter().map(String::as_str));
+    merge.extend(["-o", merged.to_str().expect("utf8")]);
+    ok(&merge, dir.path());
+    let payload = |p: &std::path::Path| {
+        let (_, g) = container::read::<yarnhom_artifacts::Grid>(p).expect("grid reads back");
+        container::payload_of(&g).expect("payload")
+    };
+    assert_eq!(payload(&merged), payload(&whole), "merged shards differ from the unsharded run");
+    // Overlapping shards are refused.
+    fails_with(&["grid", "merge", &shards[0], &shards[0], "-o", "x.grid.yh"], dir.path(), "appears in");
+    // Kill a run once its checkpoint holds finished lines; the rerun continues from there and
+    // ends with the same grid as the uninterrupted run.
+    let resumed = dir.path().join("resumed.grid.yh");
+    let checkpoint = dir.path().join("resumed.grid.yh.checkpoint");
+    let a = args(&[], resumed.to_str().expect("utf8"));
+    let mut child = Command::new(env!("CARGO_BIN_EXE_yarnhom"))
+        .args(&a)
+        .current_dir(dir.path())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("run yarnhom");
+    let header = 200;
+    while std::fs::metadata(&checkpoint).map_or(0, |m| m.len()) < 4 * header {
+        if child.try_wait().expect("child").is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    child.kill().ok();
+    child.wait().expect("child ends");
+    assert!(checkpoint.exists(), "the run was killed before it finished");
+    let o = yarnhom(&a.iter().map(String::as_str).collect::<Vec<_>>(), dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stderr(&o).contains("resumed from"), "{}", stderr(&o));
+    assert!(!checkpoint.exists(), "a finished run removes its checkpoint");
+    assert_eq!(payload(&resumed), payload(&whole), "the resumed run differs from the uninterrupted one");
+    fails_with(
+        &["rve", "sample", &tiny, "--model", "table4.1:stock-small", "--shard", "3/3"],
+        dir.path(),
+        "0 <= K < N",
+    );
 }

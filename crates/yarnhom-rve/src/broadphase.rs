@@ -2,9 +2,8 @@
 //! tile, one in a tile image within contact range ([`RveModel::images`]) — may come close. Each
 //! edge is bounded by an axis-aligned box grown by a margin (half the contact reach for yarn-yarn
 //! contact, Sec. 3.3; the swept box of a step for collision detection, A.2.3), and the tile's
-//! boxes are put in a uniform grid (a spatial hash kept as a sorted list of cells), which every
-//! image edge's box queries, so the cost grows with the number of nearby pairs rather than
-//! `E² · images`.
+//! boxes are put in a uniform grid (a spatial hash), which every image edge's box near the tile
+//! queries, so the cost grows with the number of nearby pairs rather than `E² · images`.
 
 use nalgebra::Vector3;
 
@@ -69,10 +68,7 @@ pub fn edge_pairs(model: &RveModel, boxes: &[Vec<Aabb>]) -> Vec<EdgePair> {
     let mut pairs = Vec::new();
     let mut hits = Vec::new();
     for (image, (&o, image_boxes)) in model.images.iter().zip(boxes).enumerate() {
-        if !bounds(image_boxes).overlaps(&tile_bounds) {
-            continue;
-        }
-        for (b, query) in image_boxes.iter().enumerate() {
+        for (b, query) in image_boxes.iter().enumerate().filter(|(_, q)| q.overlaps(&tile_bounds)) {
             grid.overlapping(query, &mut hits);
             let source_b = model.stretch[b].from.vertex;
             pairs.extend(
@@ -101,15 +97,23 @@ const WIDE_CELLS: f64 = 4.0;
 
 /// Buckets per axis at most: cells beyond wrap around (a spatial hash), so that boxes strewn far
 /// apart cost no memory; cells sharing a bucket only add candidates, which the exact test drops.
-const MAX_BUCKETS: f64 = 32.0;
+const MAX_BUCKETS: i64 = 32;
+
+/// A range of cells, `lo..=hi` along each axis.
+type Cells = ([i64; 3], [i64; 3]);
 
 /// A uniform grid over boxes, hashed into a table of buckets (cell coordinates modulo the table
-/// size) stored as one list: bucket `k` holds `items[starts[k]..starts[k + 1]]`, each box in
-/// the buckets of every cell it touches. The cell size is the boxes' mean largest side, so a
-/// typical box touches at most 2 cells per axis; the table spans the boxes' extent.
+/// size, which spans the boxes' cells up to [`MAX_BUCKETS`] per axis) stored as one list: bucket
+/// `k` holds `items[starts[k]..starts[k + 1]]`, each box in the buckets of every cell it touches.
+/// The cell size is the boxes' mean largest side, so a typical box touches at most 2 cells per
+/// axis and sits in a bucket with the few boxes near it.
 struct Grid<'a> {
     boxes: &'a [Aabb],
     cell: f64,
+    /// The cells touched by the boxes in the grid (empty, `lo > hi`, for none).
+    span: Cells,
+    /// The first cell of each box in the grid.
+    first: Vec<[i64; 3]>,
     buckets: [i64; 3],
     starts: Vec<usize>,
     items: Vec<usize>,
@@ -119,15 +123,29 @@ struct Grid<'a> {
 impl<'a> Grid<'a> {
     fn new(boxes: &'a [Aabb]) -> Self {
         let cell = boxes.iter().map(Aabb::largest_side).sum::<f64>() / boxes.len() as f64;
-        let extent = bounds(boxes);
-        let buckets = [0, 1, 2].map(|k| {
-            let cells = ((extent.hi[k] - extent.lo[k]) / cell).floor() + 1.0;
-            if cells.is_finite() { cells.clamp(1.0, MAX_BUCKETS) as i64 } else { MAX_BUCKETS as i64 }
+        let mut grid = Grid {
+            boxes,
+            cell,
+            span: ([i64::MAX; 3], [i64::MIN; 3]),
+            first: Vec::new(),
+            buckets: [1; 3],
+            starts: Vec::new(),
+            items: Vec::new(),
+            wide: Vec::new(),
+        };
+        let ranges: Vec<Option<Cells>> = boxes.iter().map(|b| grid.cells(b)).collect();
+        grid.first = ranges.iter().map(|r| r.map_or([0; 3], |(lo, _)| lo)).collect();
+        for &(lo, hi) in ranges.iter().flatten() {
+            grid.span = (
+                std::array::from_fn(|k| grid.span.0[k].min(lo[k])),
+                std::array::from_fn(|k| grid.span.1[k].max(hi[k])),
+            );
+        }
+        grid.buckets = std::array::from_fn(|k| {
+            grid.span.1[k].saturating_sub(grid.span.0[k]).saturating_add(1).clamp(1, MAX_BUCKETS)
         });
-        let size = (buckets[0] * buckets[1] * buckets[2]) as usize;
-        let mut grid =
-            Grid { boxes, cell, buckets, starts: vec![0; size + 1], items: Vec::new(), wide: Vec::new() };
-        let ranges: Vec<Option<([i64; 3], [i64; 3])>> = boxes.iter().map(|b| grid.cells(b)).collect();
+        let size = (grid.buckets[0] * grid.buckets[1] * grid.buckets[2]) as usize;
+        grid.starts = vec![0; size + 1];
         for &(lo, hi) in ranges.iter().flatten() {
             for c in cells_between(lo, hi) {
                 let k = grid.bucket(c);
@@ -155,7 +173,7 @@ impl<'a> Grid<'a> {
     }
 
     /// The range of cells a box touches; `None` for a box too wide for the grid (or not finite).
-    fn cells(&self, b: &Aabb) -> Option<([i64; 3], [i64; 3])> {
+    fn cells(&self, b: &Aabb) -> Option<Cells> {
         let lo = b.lo.map(|x| (x / self.cell).floor());
         let hi = b.hi.map(|x| (x / self.cell).floor());
         // Written so that NaN (an empty grid, a degenerate cell or box) counts as wide.
@@ -169,24 +187,29 @@ impl<'a> Grid<'a> {
         ((c[0].rem_euclid(nx) * ny + c[1].rem_euclid(ny)) * nz + c[2].rem_euclid(nz)) as usize
     }
 
-    /// The boxes overlapping `query` into `hits`, each once, in ascending order.
+    /// The boxes overlapping `query` into `hits`, each once (in no particular order).
     fn overlapping(&self, query: &Aabb, hits: &mut Vec<usize>) {
         hits.clear();
-        let overlapping = |i: &usize| self.boxes[*i].overlaps(query);
-        match self.cells(query) {
-            Some((lo, hi)) => {
-                for c in cells_between(lo, hi) {
-                    let k = self.bucket(c);
-                    hits.extend(
-                        self.items[self.starts[k]..self.starts[k + 1]].iter().filter(|i| overlapping(i)),
-                    );
+        let Some((lo, hi)) = self.cells(query) else {
+            hits.extend((0..self.boxes.len()).filter(|&i| self.boxes[i].overlaps(query)));
+            return;
+        };
+        let clamped = (
+            std::array::from_fn(|k| lo[k].max(self.span.0[k])),
+            std::array::from_fn(|k| hi[k].min(self.span.1[k])),
+        );
+        for c in cells_between(clamped.0, clamped.1) {
+            let k = self.bucket(c);
+            for &i in &self.items[self.starts[k]..self.starts[k + 1]] {
+                // A box touching several cells of the query counts in one: the cell of the lower
+                // corner of their intersection, which both touch.
+                let corner: [i64; 3] = std::array::from_fn(|k| self.first[i][k].max(lo[k]));
+                if corner == c && self.boxes[i].overlaps(query) {
+                    hits.push(i);
                 }
-                hits.extend(self.wide.iter().filter(|i| overlapping(i)));
             }
-            None => hits.extend((0..self.boxes.len()).filter(overlapping)),
         }
-        hits.sort_unstable();
-        hits.dedup();
+        hits.extend(self.wide.iter().filter(|&&i| self.boxes[i].overlaps(query)));
     }
 }
 
@@ -281,6 +304,14 @@ mod tests {
         }
     }
 
+    /// The boxes of `grid` overlapping `query`, sorted.
+    fn found(grid: &Grid, query: &Aabb) -> Vec<usize> {
+        let mut hits = Vec::new();
+        grid.overlapping(query, &mut hits);
+        hits.sort_unstable();
+        hits
+    }
+
     #[test]
     fn wide_and_degenerate_boxes_are_tested_directly() {
         let unit = |x: f64| Aabb { lo: Vector3::new(x, 0.0, 0.0), hi: Vector3::new(x + 1.0, 1.0, 1.0) };
@@ -289,25 +320,19 @@ mod tests {
         boxes.push(wide);
         let grid = Grid::new(&boxes);
         assert_eq!(grid.wide, [20]);
-        let mut hits = Vec::new();
-        grid.overlapping(&unit(2.5), &mut hits);
-        assert_eq!(hits, [1, 20]);
-        grid.overlapping(&wide, &mut hits);
-        assert_eq!(hits, (0..=20).collect::<Vec<_>>());
-        grid.overlapping(&unit(f64::NAN), &mut hits);
-        assert!(hits.is_empty());
+        assert_eq!(found(&grid, &unit(2.5)), [1, 20]);
+        assert_eq!(found(&grid, &wide), (0..=20).collect::<Vec<_>>());
+        assert!(found(&grid, &unit(f64::NAN)).is_empty());
         // A box that is not finite is kept apart and meets nothing.
         boxes.push(unit(f64::NAN));
         let with_nan = Grid::new(&boxes);
         assert_eq!(with_nan.wide, [20, 21]);
-        with_nan.overlapping(&unit(0.5), &mut hits);
-        assert_eq!(hits, [0, 20]);
+        assert_eq!(found(&with_nan, &unit(0.5)), [0, 20]);
         // Zero-size boxes give a zero cell: all are tested directly.
         let points = [Aabb::around_segment(&Vector3::zeros(), &Vector3::zeros(), 0.0); 2];
         let degenerate = Grid::new(&points);
         assert!(degenerate.items.is_empty());
-        degenerate.overlapping(&unit(0.0), &mut hits);
-        assert_eq!(hits, [0, 1]);
+        assert_eq!(found(&degenerate, &unit(0.0)), [0, 1]);
     }
 
     #[test]
@@ -318,10 +343,7 @@ mod tests {
         let grid = Grid::new(&boxes);
         assert_eq!(grid.buckets[0], 32);
         assert_eq!(grid.items.len(), 2 * 2 * 2 * 2);
-        let mut hits = Vec::new();
-        grid.overlapping(&unit(0.5), &mut hits);
-        assert_eq!(hits, [0]);
-        grid.overlapping(&unit(1e6 - 0.5), &mut hits);
-        assert_eq!(hits, [1]);
+        assert_eq!(found(&grid, &unit(0.5)), [0]);
+        assert_eq!(found(&grid, &unit(1e6 - 0.5)), [1]);
     }
 }

@@ -10,10 +10,13 @@
 //! - [`model`]: the tile's elements and rest state, built from a pattern and a yarn model;
 //! - [`placement`]: where vertex instances go under a macro strain;
 //! - [`assembly`]: energy, gradient and Hessian over `g`;
+//! - [`broadphase`]: the uniform-grid search for edge pairs within contact reach;
+//! - [`ccd`]: additive continuous collision detection for collision-safe steps (A.2.3);
 //! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
 //! - [`homogenize`]: energy density and stress at a macro strain;
-//! - [`relax`]: rest states (Algorithm 2, Sec. 6.5.2).
+//! - [`relax`]: rest states (Algorithm 2, Sec. 6.5.2);
+//! - [`sample`]: the sampling plan and parallel sweep engine of the energy database (App. A.3.1).
 
 pub mod assembly;
 pub mod broadphase;
@@ -23,6 +26,7 @@ pub mod linear;
 pub mod model;
 pub mod placement;
 pub mod relax;
+pub mod sample;
 pub mod solve;
 
 pub use assembly::Assembled;

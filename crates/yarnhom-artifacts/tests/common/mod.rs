@@ -2,7 +2,10 @@
 #![allow(dead_code, missing_docs)]
 
 use proptest::prelude::*;
-use yarnhom_artifacts::{Fabric, Pattern, RestState, RveSolve, StrainSample, Yarn, YarnMechanics, YarnModel};
+use yarnhom_artifacts::{
+    Fabric, Grid, GridSample, GridShard, GridTerm, Pattern, RestState, RveSolve, StrainSample, Yarn,
+    YarnMechanics, YarnModel,
+};
 
 fn finite(lo: f64, hi: f64) -> impl Strategy<Value = f64> {
     lo..hi
@@ -166,4 +169,135 @@ pub fn rve_solve() -> impl Strategy<Value = RveSolve> {
                 })
         },
     )
+}
+
+/// How one sample of a plan came out, and whether the grid keeps it.
+#[derive(Debug, Clone, Copy)]
+pub struct Outcome {
+    pub converged: bool,
+    pub energy: f64,
+    pub stress: Option<[f64; 5]>,
+    pub keep: bool,
+}
+
+/// The `(term, index)` of every sample of a plan, sorted.
+pub fn plan(axes: &[Vec<f64>; 5], terms: &[Vec<u8>]) -> Vec<(u32, [u32; 2])> {
+    let mut out = Vec::new();
+    for (t, term) in terms.iter().enumerate() {
+        let len = |k: usize| term.get(k).map_or(1, |&a| axes[a as usize].len() as u32);
+        for i in 0..len(0) {
+            for j in 0..len(1) {
+                out.push((t as u32, [i, j]));
+            }
+        }
+    }
+    out
+}
+
+/// A valid grid over a plan: sample `k` of the plan comes out as `outcomes[k % len]` (and is
+/// left out unless kept); `vertices` adds an equilibrium geometry of that many vertices.
+pub fn build_grid(
+    axes: [Vec<f64>; 5],
+    terms: Vec<Vec<u8>>,
+    outcomes: &[Outcome],
+    vertices: Option<usize>,
+) -> Grid {
+    let mut grid = Grid {
+        pattern: "rib".into(),
+        model: "rib".into(),
+        terms: terms
+            .iter()
+            .map(|t| GridTerm {
+                axes: t.clone(),
+                values: t.iter().map(|&a| axes[a as usize].clone()).collect(),
+            })
+            .collect(),
+        shard: None,
+        samples: Vec::new(),
+    };
+    for (k, (term, index)) in plan(&axes, &terms).into_iter().enumerate() {
+        let o = outcomes[k % outcomes.len()];
+        if !o.keep {
+            continue;
+        }
+        let strain = grid.strain_at(term as usize, index).expect("in the plan");
+        let geometry = vertices.map(|v| {
+            let positions =
+                (0..v).map(|i| [k as f64 * 1e-3, i as f64 * 0.1 + 0.2, -(i as f64) / 3.0]).collect();
+            (positions, (0..v).map(|i| (i + k) as f64 / 7.0).collect())
+        });
+        let (positions_m, edge_twist_rad) = geometry.unzip();
+        grid.samples.push(GridSample {
+            term,
+            index,
+            strain,
+            converged: o.converged,
+            stop_reason: if o.converged { "converged".into() } else { "iteration_limit".into() },
+            energy_density_j_m2: o.converged.then_some(o.energy),
+            stress: o.stress.filter(|_| o.converged),
+            iterations: k as u32 % 17,
+            positions_m,
+            edge_twist_rad,
+        });
+    }
+    grid
+}
+
+/// A fixed grid of four terms (two 1D, two 2D) with every sample, a few not converged, stress on
+/// some, awkward floats.
+pub fn sample_grid(vertices: Option<usize>) -> Grid {
+    let axes = [
+        vec![-0.1, 0.0, 0.1 + 0.2],
+        vec![-0.3, -0.0, f64::MIN_POSITIVE / 4.0, 0.3],
+        vec![0.0, 0.5],
+        vec![-10.0, 0.0, 1.0 / 3.0],
+        vec![0.0, 5.0],
+    ];
+    let outcomes: Vec<Outcome> = (0..7)
+        .map(|k| Outcome {
+            converged: k != 3,
+            energy: 0.1 + k as f64 * 0.37,
+            stress: (k % 2 == 0).then_some([k as f64, -0.5, 1e-300, 2.0, -0.0]),
+            keep: true,
+        })
+        .collect();
+    build_grid(axes, vec![vec![0], vec![1], vec![0, 2], vec![3, 4]], &outcomes, vertices)
+}
+
+fn axis_values() -> impl Strategy<Value = Vec<f64>> {
+    prop::collection::btree_set(-1000i32..1000, 0..5).prop_map(|set| {
+        let mut values: Vec<f64> = set.into_iter().map(|x| f64::from(x) * 1e-3).collect();
+        values.push(0.0);
+        values.sort_by(f64::total_cmp);
+        values.dedup();
+        values
+    })
+}
+
+fn outcome() -> impl Strategy<Value = Outcome> {
+    (
+        any::<bool>(),
+        0.0f64..10.0,
+        prop::option::of(prop::array::uniform5(-10.0f64..10.0)),
+        prop::bool::weighted(0.8),
+    )
+        .prop_map(|(converged, energy, stress, keep)| Outcome { converged, energy, stress, keep })
+}
+
+/// A valid grid: random axes and terms, some samples left out, maybe a shard and a geometry.
+pub fn grid() -> impl Strategy<Value = Grid> {
+    let all_terms: Vec<Vec<u8>> =
+        (0..5u8).map(|a| vec![a]).chain((0..5u8).flat_map(|a| (a + 1..5).map(move |b| vec![a, b]))).collect();
+    (
+        prop::array::uniform5(axis_values()),
+        prop::sample::subsequence(all_terms, 1..6),
+        prop::collection::vec(outcome(), 1..40),
+        prop::option::of(1usize..6),
+        prop::option::of((0u32..4, 1u32..4)),
+    )
+        .prop_map(|(axes, terms, outcomes, vertices, shard)| {
+            let mut grid = build_grid(axes, terms, &outcomes, vertices);
+            grid.shard = shard.map(|(i, extra)| GridShard { index: i, count: i + extra });
+            grid
+        })
 }
