@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # The README's main command: yarnhom's pipeline on built-in defaults, printing where each
 # artifact went. Today: published and generated patterns, the Table 4.1 yarn models,
-# inspection, conversion (JSON, HDF5, .pyp), periodic tile solves, a rest-state relaxation and
-# semantic diff. Later stages (sample -> fit -> simulate) join it as they land.
+# inspection, conversion (JSON, HDF5, .pyp), periodic tile solves, a rest-state relaxation, a
+# reduced sampling sweep and semantic diff. Later stages (fit -> simulate) join it as they land.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
@@ -38,6 +38,11 @@ echo "== rest state (Algorithm 2): the generated stockinette relaxed with the Ta
 yarnhom rve relax "$out/gen-stockinette.pattern.yh" --model table4.1:stock -o "$out/gen-stockinette.relaxed.pattern.yh"
 yarnhom rve solve "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --strain sx=0.2 \
   -o "$out/gen-stockinette-sx0.2.rvesolve.yh"
+
+echo "== sampling sweep (App. A.3.1, reduced plan: 9 values per 1D term, 3 x 3 per 2D term) -> $out/gen-stockinette.grid.yh"
+yarnhom rve sample "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --n1d 9 --n2d 3 \
+  -o "$out/gen-stockinette.grid.yh"
+yarnhom convert "$out/gen-stockinette.grid.yh" --to hdf5 -o "$out/gen-stockinette.grid.h5"
 
 echo "== semantic diff: the HDF5 export against the original (equal), stockinette against rib (different)"
 yarnhom diff "$out/rib.pattern.yh" "$out/rib.pattern.h5"
