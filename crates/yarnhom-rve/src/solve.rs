@@ -143,9 +143,14 @@ pub(crate) fn constraints(model: &RveModel, placement: &Placement) -> DMatrix<f6
     c
 }
 
+/// `(C Cᵀ)⁻¹ rhs` (zero if the constraints were dependent).
+fn gram_solve(c: &DMatrix<f64>, rhs: &DVector<f64>) -> DVector<f64> {
+    (c * c.transpose()).lu().solve(rhs).unwrap_or_else(|| DVector::zeros(c.nrows()))
+}
+
 /// The least-squares constraint multipliers `λ` of `∇E ≈ Cᵀλ`: the constraint forces.
 pub(crate) fn multipliers(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
-    (c * c.transpose()).lu().solve(&(c * gradient)).unwrap_or_else(|| DVector::zeros(c.nrows()))
+    gram_solve(c, &(c * gradient))
 }
 
 /// Gradient projected onto the tangent space of `C g = d` (A.31-A.32).
@@ -165,14 +170,13 @@ pub fn solve(
     let c = constraints(model, placement);
     let affine = RveState::affine(model, placement);
     // The constraint values are those of the affine start (zero mean fluctuation, the pattern's
-    // total twist, boundary vertices on the boundary), also for a warm start: its own values
-    // were taken under another strain's boundary normal, and the step restores these.
+    // total twist, no mean sliding), also for a warm start, whose sliding was measured along
+    // another strain's tangents: move it onto these constraints first (the least-norm
+    // correction); Newton steps then keep them exactly.
     let target = &c * &affine.g;
-    // A warm start met the constraints of another strain: move it onto these first (the
-    // least-norm correction; Newton steps then keep them exactly).
     let violation = &c * &state.g - &target;
     if violation.amax() > 0.0 {
-        state.g -= c.transpose() * (&c * c.transpose()).lu().solve(&violation).unwrap_or(violation);
+        state.g -= c.transpose() * gram_solve(&c, &violation);
         state.update_frames(model, placement);
     }
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * r });
