@@ -1,90 +1,220 @@
-//! The published ARCSim-HYLC fitted materials (`../shared/data/hylc-materials/*.json`, see
-//! FORMAT.md there): read far enough to evaluate the 1D terms. The full spline model (2D
-//! patches, bending split) belongs to the fitting stage.
+//! The ARCSim-HYLC material JSON (`../shared/data/hylc-materials/*.json`, FORMAT.md there): the
+//! published fitted materials of thesis Ch. 4, read into and written from the [`Spline`]
+//! artifact, so published materials run in our simulator and our fits run in theirs.
+//!
+//! The layout, as read by ARCSim-HYLC's `SplineMaterial`:
+//! - `density` (kg/m²), `strain scale` [5], `strain shift` = `[1, 0, 1, 0, 0]` (the in-plane
+//!   strains are stretch ratios minus 1);
+//! - `coeffs.const` = `f0`;
+//! - `coeffs.1D[]` = `{k, t, p, m}`: knots, values, slopes of term `k`;
+//! - `coeffs.2D[]` = `{k0, k1, tu, tv, p, mu, mv, muv}`, nodal arrays row-major with `tv` outer
+//!   (`p[iv * len(tu) + iu]`), the layout of [`BicubicTerm`].
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
+use crate::Artifact;
 use crate::error::{Error, Result};
+use crate::spline::{BicubicTerm, CubicTerm, Spline, SplineOrigin};
 
-/// One 1D term: a cubic Hermite spline over `strain / strain scale`.
-#[derive(Debug, Clone, Deserialize)]
+/// The strain shift ARCSim-HYLC applies: `sx = sqrt(I11) - 1`, `sy = sqrt(I22) - 1`.
+const STRAIN_SHIFT: [f64; 5] = [1.0, 0.0, 1.0, 0.0, 0.0];
+
+/// An ARCSim-HYLC material file.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ArcsimMaterial {
+    /// Areal mass density (kg/m²).
+    pub density: f64,
+    /// Normalization of `(sx, sa, sy, kx, ky)`.
+    #[serde(rename = "strain scale")]
+    pub strain_scale: [f64; 5],
+    /// Shift of the strains before normalization; `[1, 0, 1, 0, 0]`.
+    #[serde(rename = "strain shift")]
+    pub strain_shift: [f64; 5],
+    /// The spline coefficients.
+    pub coeffs: Coefficients,
+}
+
+/// The coefficients of an ARCSim-HYLC material.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Coefficients {
+    /// `f0` (J/m²).
+    #[serde(rename = "const")]
+    pub constant: f64,
+    /// The 1D terms.
+    #[serde(rename = "1D")]
+    pub terms_1d: Vec<Term1d>,
+    /// The 2D terms.
+    #[serde(rename = "2D", default)]
+    pub terms_2d: Vec<Term2d>,
+}
+
+/// One 1D term.
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Term1d {
     /// Strain index: 0 sx, 1 sa, 2 sy, 3 x-bending, 4 y-bending.
-    pub k: usize,
-    /// Knots (normalized strain).
+    pub k: u8,
+    /// Knots.
     pub t: Vec<f64>,
-    /// Values at the knots (J/m²).
+    /// Values.
     pub p: Vec<f64>,
-    /// Slopes at the knots.
+    /// Slopes.
     pub m: Vec<f64>,
 }
 
-#[derive(Debug, Clone, Deserialize)]
-struct Coefficients {
-    #[serde(rename = "1D")]
-    terms_1d: Vec<Term1d>,
+/// One 2D term.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Term2d {
+    /// First strain index (in-plane).
+    pub k0: u8,
+    /// Second strain index.
+    pub k1: u8,
+    /// Knots of the first strain.
+    pub tu: Vec<f64>,
+    /// Knots of the second strain.
+    pub tv: Vec<f64>,
+    /// Values.
+    pub p: Vec<f64>,
+    /// u-derivatives.
+    pub mu: Vec<f64>,
+    /// v-derivatives.
+    pub mv: Vec<f64>,
+    /// Cross derivatives.
+    pub muv: Vec<f64>,
 }
 
-/// A published HYLC fit, as far as its 1D terms.
-#[derive(Debug, Clone, Deserialize)]
-pub struct HylcFit {
-    /// Normalization of (sx, sa, sy, kx, ky).
-    #[serde(rename = "strain scale")]
-    pub strain_scale: [f64; 5],
-    coeffs: Coefficients,
+fn format_error(line: usize, message: impl Into<String>) -> Error {
+    Error::Format { format: "ARCSim-HYLC JSON", line, message: message.into() }
 }
 
-impl HylcFit {
-    /// Parse the JSON text of a fit.
+impl ArcsimMaterial {
+    /// Parse the JSON text of a material (ARCSim's JSON allows `//` comments; so do we).
     pub fn parse(text: &str) -> Result<Self> {
-        let fit: HylcFit = serde_json::from_str(text).map_err(|e| Error::Format {
-            format: "ARCSim-HYLC JSON",
-            line: e.line(),
-            message: e.to_string(),
-        })?;
-        for term in &fit.coeffs.terms_1d {
-            let n = term.t.len();
-            if term.k > 4
-                || n < 2
-                || term.p.len() != n
-                || term.m.len() != n
-                || term.t.windows(2).any(|w| w[1] <= w[0])
-            {
-                return Err(Error::Format {
-                    format: "ARCSim-HYLC JSON",
-                    line: 0,
-                    message: format!(
-                        "1D term {} is malformed (knots must increase, arrays agree in length)",
-                        term.k
-                    ),
-                });
-            }
+        let text = strip_line_comments(text);
+        let material: Self =
+            serde_json::from_str(&text).map_err(|e| format_error(e.line(), e.to_string()))?;
+        if material.strain_shift != STRAIN_SHIFT {
+            return Err(format_error(
+                0,
+                format!("strain shift must be {STRAIN_SHIFT:?} (stretch ratio minus 1), got {:?}", material.strain_shift),
+            ));
         }
-        Ok(fit)
+        Ok(material)
     }
 
-    /// The 1D term `k` at strain `x` (J/m²): cubic Hermite over `x / strain scale`, extrapolated
-    /// linearly with the end slope. `None` if the fit has no such term.
-    pub fn term_1d(&self, k: usize, x: f64) -> Option<f64> {
-        let term = self.coeffs.terms_1d.iter().find(|t| t.k == k)?;
-        let (t, p, m) = (&term.t, &term.p, &term.m);
-        let (u, last) = (x / self.strain_scale[k], t.len() - 1);
-        if u <= t[0] {
-            return Some(p[0] + m[0] * (u - t[0]));
+    /// The material as a [`Spline`] artifact named `name`, validated.
+    pub fn to_spline(&self, name: &str, file: &str) -> Result<Spline> {
+        let spline = Spline {
+            name: name.into(),
+            areal_density_kg_m2: self.density,
+            strain_scale: self.strain_scale,
+            rest_energy_density_j_m2: self.coeffs.constant,
+            terms_1d: self
+                .coeffs
+                .terms_1d
+                .iter()
+                .map(|t| CubicTerm { axis: t.k, knots: t.t.clone(), values: t.p.clone(), slopes: t.m.clone() })
+                .collect(),
+            terms_2d: self
+                .coeffs
+                .terms_2d
+                .iter()
+                .map(|t| BicubicTerm {
+                    axes: [t.k0, t.k1],
+                    u_knots: t.tu.clone(),
+                    v_knots: t.tv.clone(),
+                    values: t.p.clone(),
+                    du: t.mu.clone(),
+                    dv: t.mv.clone(),
+                    duv: t.muv.clone(),
+                })
+                .collect(),
+            origin: SplineOrigin::ImportedArcsim { file: file.into() },
+        };
+        spline.validate().map_err(|e| format_error(0, format!("{}: {}", e.field, e.problem)))?;
+        Ok(spline)
+    }
+
+    /// A [`Spline`] in the ARCSim-HYLC layout.
+    pub fn from_spline(spline: &Spline) -> Self {
+        Self {
+            density: spline.areal_density_kg_m2,
+            strain_scale: spline.strain_scale,
+            strain_shift: STRAIN_SHIFT,
+            coeffs: Coefficients {
+                constant: spline.rest_energy_density_j_m2,
+                terms_1d: spline
+                    .terms_1d
+                    .iter()
+                    .map(|t| Term1d { k: t.axis, t: t.knots.clone(), p: t.values.clone(), m: t.slopes.clone() })
+                    .collect(),
+                terms_2d: spline
+                    .terms_2d
+                    .iter()
+                    .map(|t| Term2d {
+                        k0: t.axes[0],
+                        k1: t.axes[1],
+                        tu: t.u_knots.clone(),
+                        tv: t.v_knots.clone(),
+                        p: t.values.clone(),
+                        mu: t.du.clone(),
+                        mv: t.dv.clone(),
+                        muv: t.duv.clone(),
+                    })
+                    .collect(),
+            },
         }
-        if u >= t[last] {
-            return Some(p[last] + m[last] * (u - t[last]));
+    }
+
+    /// The JSON text ARCSim-HYLC reads.
+    pub fn to_json(&self) -> Result<String> {
+        serde_json::to_string_pretty(self).map_err(|e| Error::Encode { what: "ARCSim-HYLC JSON", message: e.to_string() })
+    }
+}
+
+/// Read an ARCSim-HYLC material file into a validated [`Spline`] named after the file's stem.
+pub fn read_spline(path: &std::path::Path) -> Result<Spline> {
+    let text = std::fs::read_to_string(path).map_err(|e| Error::from(e).at(path))?;
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("material");
+    let file = path.file_name().and_then(|s| s.to_str()).unwrap_or(stem);
+    ArcsimMaterial::parse(&text).and_then(|m| m.to_spline(stem, file)).map_err(|e| e.at(path))
+}
+
+/// Remove `//` comments outside strings (ARCSim's JSON dialect).
+pub fn strip_line_comments(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut in_string = false;
+        let mut escaped = false;
+        let mut cut = line.len();
+        let bytes = line.as_bytes();
+        for (i, &b) in bytes.iter().enumerate() {
+            match b {
+                b'\\' if in_string => escaped = !escaped,
+                b'"' if !escaped => in_string = !in_string,
+                b'/' if !in_string && bytes.get(i + 1) == Some(&b'/') => {
+                    cut = i;
+                    break;
+                }
+                _ => escaped = false,
+            }
+            if b != b'\\' {
+                escaped = false;
+            }
         }
-        let i = t.iter().position(|&ti| ti > u).unwrap_or(last) - 1;
-        let h = t[i + 1] - t[i];
-        let s = (u - t[i]) / h;
-        let (s2, s3) = (s * s, s * s * s);
-        Some(
-            (2.0 * s3 - 3.0 * s2 + 1.0) * p[i]
-                + (s3 - 2.0 * s2 + s) * h * m[i]
-                + (-2.0 * s3 + 3.0 * s2) * p[i + 1]
-                + (s3 - s2) * h * m[i + 1],
-        )
+        out.push_str(&line[..cut]);
+        out.push('\n');
+    }
+    out
+}
+
+impl Artifact for Spline {
+    const KIND: &'static str = "spline";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), crate::ValidationError> {
+        Spline::validate(self)
+    }
+    fn summary(&self) -> String {
+        Spline::summary(self)
     }
 }
 
@@ -92,24 +222,43 @@ impl HylcFit {
 mod tests {
     use super::*;
 
-    const FIT: &str = r#"{"strain scale": [0.5, 1, 1, 1, 1], "coeffs": {"const": 0.1,
-        "1D": [{"k": 0, "t": [0, 1, 2], "p": [0, 1, 4], "m": [0, 2, 4]}]}}"#;
+    const FIT: &str = r#"{"density": 0.3, "strain scale": [0.5, 1, 1, 1, 1], "strain shift": [1, 0, 1, 0, 0],
+        "coeffs": {"const": 0.1,
+        "1D": [{"k": 0, "t": [0, 1, 2], "p": [0, 1, 4], "m": [0, 2, 4]}], // a comment
+        "2D": [{"k0": 0, "k1": 3, "tu": [0, 1], "tv": [0, 1, 2], "p": [0,0,0,0,0,1], "mu": [0,0,0,0,0,0], "mv": [0,0,0,0,0,0], "muv": [0,0,0,0,0,0]}]}}"#;
 
     #[test]
-    fn hermite_terms_interpolate_knots_and_extrapolate_linearly() {
-        let fit = HylcFit::parse(FIT).expect("parses");
-        // p = u² with exact slopes: the Hermite spline reproduces the quadratic.
-        for u in [0.0, 0.3, 1.0, 1.7, 2.0] {
-            assert!((fit.term_1d(0, 0.5 * u).expect("term") - u * u).abs() < 1e-12, "u = {u}");
-        }
-        assert!((fit.term_1d(0, 0.5 * 3.0).expect("term") - (4.0 + 4.0)).abs() < 1e-12);
-        assert!(fit.term_1d(2, 0.1).is_none());
+    fn round_trip_keeps_every_coefficient() {
+        let material = ArcsimMaterial::parse(FIT).expect("parses");
+        let spline = material.to_spline("fit", "fit.json").expect("valid");
+        assert_eq!(spline.terms_1d[0].values, vec![0.0, 1.0, 4.0]);
+        assert_eq!(spline.terms_2d[0].axes, [0, 3]);
+        let back = ArcsimMaterial::parse(&ArcsimMaterial::from_spline(&spline).to_json().expect("json")).expect("parses");
+        assert_eq!(back.to_spline("fit", "fit.json").expect("valid"), spline);
     }
 
     #[test]
-    fn malformed_fits_are_errors() {
-        assert!(HylcFit::parse("{}").is_err());
-        let bad = FIT.replace("[0, 1, 2]", "[0, 2, 1]");
-        assert!(HylcFit::parse(&bad).is_err());
+    fn malformed_materials_are_errors() {
+        assert!(ArcsimMaterial::parse("{}").is_err());
+        let bad = ArcsimMaterial::parse(&FIT.replace("[0, 1, 2]", "[0, 2, 1]")).expect("parses");
+        let message = bad.to_spline("fit", "fit.json").expect_err("unsorted knots").to_string();
+        assert!(message.contains("terms_1d[0].knots"), "{message}");
+        assert!(ArcsimMaterial::parse(&FIT.replace("[1, 0, 1, 0, 0]", "[0, 0, 0, 0, 0]")).is_err());
+    }
+
+    #[test]
+    fn every_published_material_imports() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/hylc-materials");
+        let mut count = 0;
+        for entry in std::fs::read_dir(&dir).expect("the published materials").flatten() {
+            let path = entry.path();
+            if path.extension().is_some_and(|e| e == "json") {
+                let spline = read_spline(&path).expect("published material imports");
+                assert_eq!(spline.terms_1d.len(), 5, "{}", path.display());
+                assert_eq!(spline.terms_2d.len(), 9, "{}", path.display());
+                count += 1;
+            }
+        }
+        assert_eq!(count, 7);
     }
 }

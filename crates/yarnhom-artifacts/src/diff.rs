@@ -13,6 +13,7 @@ use crate::AnyArtifact;
 use crate::grid::{Grid, GridSample, GridTerm};
 use crate::pattern::Pattern;
 use crate::rvesolve::RveSolve;
+use crate::spline::Spline;
 use crate::yarnmodel::YarnModel;
 
 /// Tolerances of a comparison.
@@ -158,6 +159,7 @@ pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
         (AnyArtifact::YarnModel(a), AnyArtifact::YarnModel(b)) => diff_yarn_models(a, b, tol),
         (AnyArtifact::RveSolve(a), AnyArtifact::RveSolve(b)) => diff_rve_solves(a, b, tol),
         (AnyArtifact::Grid(a), AnyArtifact::Grid(b)) => diff_grids(a, b, tol),
+        (AnyArtifact::Spline(a), AnyArtifact::Spline(b)) => diff_splines(a, b, tol),
         _ => {
             let mut d = Diff::new(a.kind());
             d.structural.push(format!("kinds differ: {} vs {}", a.kind(), b.kind()));
@@ -231,6 +233,50 @@ pub fn diff_yarn_models(a: &YarnModel, b: &YarnModel, tol: Tolerance) -> Diff {
     }
     for ((name, x), (_, y)) in pa.iter().zip(&pb) {
         d.values(name, &[*x], &[*y], tol);
+    }
+    d
+}
+
+/// Compare two spline materials coefficient by coefficient: scalars, then each term present in
+/// both with the same knots. Terms only in one, or with other knots, are structural differences
+/// (comparing the energies they evaluate to needs the evaluator, `yarnhom-fit`).
+pub fn diff_splines(a: &Spline, b: &Spline, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("spline");
+    if a.name != b.name {
+        d.notes.push(format!("names differ: '{}' vs '{}'", a.name, b.name));
+    }
+    d.values("areal_density_kg_m2", &[a.areal_density_kg_m2], &[b.areal_density_kg_m2], tol);
+    d.values("strain_scale", &a.strain_scale, &b.strain_scale, tol);
+    d.values("rest_energy_density_j_m2", &[a.rest_energy_density_j_m2], &[b.rest_energy_density_j_m2], tol);
+    for ta in &a.terms_1d {
+        let name = crate::grid::AXIS_NAMES.get(ta.axis as usize).copied().unwrap_or("?");
+        match b.terms_1d.iter().find(|tb| tb.axis == ta.axis) {
+            Some(tb) if tb.knots == ta.knots => {
+                d.values(&format!("f_{name}.values"), &ta.values, &tb.values, tol);
+                d.values(&format!("f_{name}.slopes"), &ta.slopes, &tb.slopes, tol);
+            }
+            Some(_) => d.structural.push(format!("f_{name}: knots differ")),
+            None => d.structural.push(format!("f_{name}: only in the first")),
+        }
+    }
+    for ta in &a.terms_2d {
+        let name = ta.name();
+        match b.terms_2d.iter().find(|tb| tb.axes == ta.axes) {
+            Some(tb) if tb.u_knots == ta.u_knots && tb.v_knots == ta.v_knots => {
+                for (field, x, y) in
+                    [("values", &ta.values, &tb.values), ("du", &ta.du, &tb.du), ("dv", &ta.dv, &tb.dv), ("duv", &ta.duv, &tb.duv)]
+                {
+                    d.values(&format!("f_{{{name}}}.{field}"), x, y, tol);
+                }
+            }
+            Some(_) => d.structural.push(format!("f_{{{name}}}: knots differ")),
+            None => d.structural.push(format!("f_{{{name}}}: only in the first")),
+        }
+    }
+    let only_second_1d = b.terms_1d.iter().filter(|tb| !a.terms_1d.iter().any(|ta| ta.axis == tb.axis)).count();
+    let only_second_2d = b.terms_2d.iter().filter(|tb| !a.terms_2d.iter().any(|ta| ta.axes == tb.axes)).count();
+    if only_second_1d + only_second_2d > 0 {
+        d.structural.push(format!("{} terms only in the second", only_second_1d + only_second_2d));
     }
     d
 }

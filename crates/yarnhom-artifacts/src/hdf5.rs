@@ -175,6 +175,10 @@ pub fn export(path: &Path, header: &Header, artifact: &AnyArtifact) -> Result<()
             format: FORMAT,
             message: "a yarnmodel holds no arrays, so it has no HDF5 layout; use `--to json`".into(),
         }),
+        AnyArtifact::Spline(_) => Err(Error::Unrepresentable {
+            format: FORMAT,
+            message: "a spline material is small and nested; use `--to json` or `fit export-arcsim`".into(),
+        }),
         AnyArtifact::RveSolve(_) => Err(Error::Unrepresentable {
             format: FORMAT,
             message: "rvesolve has no HDF5 layout yet (grids of solves will); use `--to json`".into(),

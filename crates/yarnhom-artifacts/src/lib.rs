@@ -3,7 +3,7 @@
 //! - [`container`]: the versioned `.yh` framing shared by every kind (magic, header, zstd
 //!   msgpack payload, checksum), atomic writes, migrations of older schema versions.
 //! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`),
-//!   [`rvesolve::RveSolve`] (`rvesolve`), [`grid::Grid`] (`grid`).
+//!   [`rvesolve::RveSolve`] (`rvesolve`), [`grid::Grid`] (`grid`), [`spline::Spline`] (`spline`).
 //! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
@@ -20,6 +20,7 @@ pub mod pattern;
 pub mod pyp;
 pub mod rvesolve;
 pub mod schema;
+pub mod spline;
 pub mod yarnmodel;
 
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
@@ -29,6 +30,7 @@ pub use error::{Error, Result, ValidationError};
 pub use grid::{Grid, GridSample, GridShard, GridTerm, MergeError};
 pub use pattern::{Fabric, Pattern, RestState, Yarn};
 pub use rvesolve::{RveSolve, StrainSample};
+pub use spline::{BicubicTerm, CubicTerm, FitSettings, Spline, SplineOrigin};
 pub use yarnmodel::{YarnMechanics, YarnModel};
 
 /// A kind of artifact: a serde type with a name, a schema version, invariants and migrations.
@@ -179,6 +181,7 @@ artifact_kinds! {
     YarnModel => YarnModel,
     RveSolve => RveSolve,
     Grid => Grid,
+    Spline => Spline,
 }
 
 impl AnyArtifact {

@@ -1,7 +1,8 @@
 //! Physics of the published patterns with their Table 4.1 parameters (issue 3, "Validation").
 //! About 7 s in all (the rib tile's solves take 3 s each).
 
-use yarnhom_artifacts::arcsim::HylcFit;
+use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_fit::SplineMaterial;
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::solve_at;
@@ -41,7 +42,7 @@ fn honeycomb_contracts_sideways_when_stretched() {
 /// The published HYLC fit's 1D term `k` (0 = sx) at strain `x`.
 fn published_term(name: &str, k: usize, x: f64) -> f64 {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}1.json", env!("CARGO_MANIFEST_DIR"));
-    let fit = HylcFit::parse(&std::fs::read_to_string(&path).expect("fit")).expect("published fit parses");
+    let fit = SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published fit imports"));
     fit.term_1d(k, x).expect("the fit has the term")
 }
 
