@@ -1,0 +1,102 @@
+//! Error type of the crate.
+
+/// Everything that can go wrong while writing or reading a trace.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum TraceError {
+    /// An I/O error from the underlying file, pipe or stream (including one reported through
+    /// the MCAP library).
+    #[error("trace I/O error: {0}")]
+    Io(#[from] std::io::Error),
+
+    /// The MCAP container is malformed or could not be written.
+    #[error("MCAP error: {0}")]
+    Mcap(#[source] mcap::McapError),
+
+    /// A message could not be encoded as MessagePack.
+    #[error("failed to encode message for topic {topic}: {source}")]
+    Encode {
+        /// Topic of the message.
+        topic: &'static str,
+        /// Underlying MessagePack error.
+        source: rmp_serde::encode::Error,
+    },
+
+    /// A message payload could not be decoded as the topic's message type.
+    #[error("failed to decode message on topic {topic}: {source}")]
+    Decode {
+        /// Topic of the message.
+        topic: String,
+        /// Underlying MessagePack error.
+        source: rmp_serde::decode::Error,
+    },
+
+    /// A known topic uses a message encoding other than `msgpack`.
+    #[error("topic {topic}: unsupported message encoding {encoding:?} (expected \"msgpack\")")]
+    UnsupportedEncoding {
+        /// Topic of the channel.
+        topic: String,
+        /// Message encoding found in the channel record.
+        encoding: String,
+    },
+
+    /// A known topic carries a layout version this crate does not read.
+    #[error(
+        "topic {topic}: unsupported topic version {found:?} in channel metadata \
+         (this reader supports version {supported})"
+    )]
+    UnsupportedTopicVersion {
+        /// Topic of the channel.
+        topic: String,
+        /// Value of `yarnhom_topic_version` in the channel metadata, if present.
+        found: Option<String>,
+        /// The version this crate reads.
+        supported: u32,
+    },
+
+    /// A message time cannot be represented as an MCAP timestamp.
+    #[error(
+        "topic {topic}: time_s = {time_s} cannot be stored as an MCAP timestamp \
+         (it must be finite, >= 0 and below about 584 years)"
+    )]
+    InvalidTime {
+        /// Topic of the message.
+        topic: &'static str,
+        /// The offending time in seconds.
+        time_s: f64,
+    },
+
+    /// A caller-supplied metadata entry uses a key reserved by this crate.
+    #[error("metadata key {key:?} is reserved by yarnhom-trace")]
+    ReservedMetadataKey {
+        /// The offending key.
+        key: String,
+    },
+
+    /// A `yarnhom` metadata record lacks a required entry.
+    #[error("the `yarnhom` metadata record lacks the required key {key:?}")]
+    MissingMetadataKey {
+        /// The missing key.
+        key: &'static str,
+    },
+
+    /// A JSON Schema could not be serialized (should not happen for the types in this crate).
+    #[error("failed to serialize the JSON Schema of topic {topic}: {source}")]
+    Schema {
+        /// Topic whose schema failed.
+        topic: &'static str,
+        /// Underlying JSON error.
+        source: serde_json::Error,
+    },
+}
+
+impl From<mcap::McapError> for TraceError {
+    /// Lifts MCAP's I/O errors into [`TraceError::Io`]: `mcap::McapError::Io` displays only a
+    /// generic sentence, which would hide e.g. "Broken pipe" or "No space left on device".
+    fn from(err: mcap::McapError) -> Self {
+        match err {
+            mcap::McapError::Io(io) => Self::Io(io),
+            other => Self::Mcap(other),
+        }
+    }
+}

@@ -1,0 +1,463 @@
+//! Writing traces.
+
+use std::collections::BTreeMap;
+use std::ffi::OsString;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, BufWriter, Seek, SeekFrom, Stdout, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use mcap::records::MessageHeader;
+use mcap::write::NoSeek;
+
+use crate::messages::{
+    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep,
+    TOPIC_VERSION_KEY, Topic,
+};
+use crate::{TraceError, TraceMetadata};
+
+/// Default target size of an uncompressed chunk, in bytes (1 MiB, the MCAP library's default).
+///
+/// Readers hold one chunk in memory at a time, so this bounds their memory use, except that a
+/// single message larger than the target gets a chunk of its own.
+pub const DEFAULT_CHUNK_SIZE: u64 = 1024 * 1024;
+
+/// Options for [`TraceWriter`]; the constructors of [`TraceWriter`] use the defaults.
+#[derive(Debug, Clone)]
+pub struct TraceWriterOptions {
+    chunk_size: u64,
+    compress: bool,
+}
+
+impl Default for TraceWriterOptions {
+    fn default() -> Self {
+        Self {
+            chunk_size: DEFAULT_CHUNK_SIZE,
+            compress: true,
+        }
+    }
+}
+
+impl TraceWriterOptions {
+    /// The defaults: zstd compression, chunks of [`DEFAULT_CHUNK_SIZE`] bytes.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Sets the target uncompressed chunk size in bytes. A chunk is closed once it grows past
+    /// this size. When writing to a non-seekable stream, the current chunk is buffered in
+    /// memory, so this also bounds the writer's memory.
+    #[must_use]
+    pub fn chunk_size(mut self, bytes: u64) -> Self {
+        self.chunk_size = bytes;
+        self
+    }
+
+    /// Enables (the default) or disables zstd compression of chunks.
+    #[must_use]
+    pub fn compression(mut self, zstd: bool) -> Self {
+        self.compress = zstd;
+        self
+    }
+
+    fn mcap_options(&self, seeking: bool) -> mcap::WriteOptions {
+        mcap::WriteOptions::new()
+            .compression(self.compress.then_some(mcap::Compression::Zstd))
+            .chunk_size(Some(self.chunk_size))
+            .library(format!(
+                "yarnhom-trace/{}; {}",
+                env!("CARGO_PKG_VERSION"),
+                mcap::LIBRARY_IDENTIFIER
+            ))
+            .disable_seeking(!seeking)
+    }
+
+    /// Starts a trace file at `path`, written atomically: the data goes to a temporary file in
+    /// the same directory, which [`TraceWriter::finish`] renames to `path`. If the writer is
+    /// dropped without `finish`, the temporary file is deleted and `path` is left untouched.
+    pub fn create(&self, path: impl AsRef<Path>) -> Result<TraceWriter<AtomicFile>, TraceError> {
+        let file = AtomicFile::create(path.as_ref())?;
+        let mut writer = self.seekable(file)?;
+        writer.on_finish = Some(AtomicFile::commit);
+        Ok(writer)
+    }
+
+    /// Starts a trace on any seekable output (a [`File`], an [`io::Cursor`], ...).
+    pub fn seekable<W: Write + Seek>(&self, out: W) -> Result<TraceWriter<W>, TraceError> {
+        TraceWriter::from_mcap_options(out, self.mcap_options(true))
+    }
+
+    /// Starts a trace on a non-seekable output such as a pipe or socket. Each chunk is buffered
+    /// in memory and written whole; wrap unbuffered outputs in a [`BufWriter`] so the few small
+    /// records outside chunks are not written one syscall each.
+    pub fn non_seeking<O: Write>(&self, out: O) -> Result<TraceWriter<NoSeek<O>>, TraceError> {
+        TraceWriter::from_mcap_options(NoSeek::new(out), self.mcap_options(false))
+    }
+
+    /// Starts a trace on standard output. Nothing else may write to standard output while the
+    /// trace is being written.
+    pub fn to_stdout(&self) -> Result<TraceWriter<NoSeek<BufWriter<Stdout>>>, TraceError> {
+        self.non_seeking(BufWriter::new(io::stdout()))
+    }
+}
+
+/// Per-topic state of a registered channel.
+#[derive(Debug, Clone, Copy)]
+struct ChannelState {
+    id: u16,
+    /// Messages written on the channel so far (the sequence of frameless messages).
+    count: u32,
+}
+
+/// Writes a yarnhom trace as MCAP.
+///
+/// Schemas and channels are registered lazily, on the first message of each topic. Call
+/// [`finish`](Self::finish) to complete the trace: it writes the summary section and reports any
+/// error. Dropping the writer without `finish` abandons the trace: a file started with
+/// [`create`](Self::create) is deleted, and a stream is left truncated, so that a reader reports
+/// an error at its end rather than mistaking it for a complete trace.
+pub struct TraceWriter<W: Write + Seek> {
+    /// `Some` until `finish` or `drop` takes it; both consume the writer.
+    mcap: Option<mcap::Writer<W>>,
+    channels: BTreeMap<&'static str, ChannelState>,
+    /// Reused MessagePack buffer.
+    buf: Vec<u8>,
+    /// Runs on the flushed output once the MCAP is complete (the atomic rename of `create`).
+    on_finish: Option<fn(&mut W) -> io::Result<()>>,
+}
+
+impl TraceWriter<AtomicFile> {
+    /// Starts a trace file at `path` with default options, written atomically; see
+    /// [`TraceWriterOptions::create`].
+    pub fn create(path: impl AsRef<Path>) -> Result<Self, TraceError> {
+        TraceWriterOptions::default().create(path)
+    }
+}
+
+impl TraceWriter<NoSeek<BufWriter<Stdout>>> {
+    /// Starts a trace on standard output with default options; see
+    /// [`TraceWriterOptions::to_stdout`].
+    pub fn to_stdout() -> Result<Self, TraceError> {
+        TraceWriterOptions::default().to_stdout()
+    }
+}
+
+impl<O: Write> TraceWriter<NoSeek<O>> {
+    /// Starts a trace on a non-seekable output with default options; see
+    /// [`TraceWriterOptions::non_seeking`].
+    pub fn non_seeking(out: O) -> Result<Self, TraceError> {
+        TraceWriterOptions::default().non_seeking(out)
+    }
+}
+
+impl<W: Write + Seek> TraceWriter<W> {
+    /// Starts a trace on a seekable output with default options; see
+    /// [`TraceWriterOptions::seekable`].
+    pub fn new(out: W) -> Result<Self, TraceError> {
+        TraceWriterOptions::default().seekable(out)
+    }
+
+    fn from_mcap_options(out: W, options: mcap::WriteOptions) -> Result<Self, TraceError> {
+        Ok(Self {
+            mcap: Some(options.create(out)?),
+            channels: BTreeMap::new(),
+            buf: Vec::new(),
+            on_finish: None,
+        })
+    }
+
+    fn mcap(&mut self) -> &mut mcap::Writer<W> {
+        match self.mcap.as_mut() {
+            Some(mcap) => mcap,
+            None => unreachable!("the MCAP writer is only taken by finish() and drop()"),
+        }
+    }
+
+    /// Writes a mesh's rest state on `/mesh/topology`. Write it before the mesh's frames.
+    pub fn write_topology(&mut self, topology: &MeshTopology) -> Result<(), TraceError> {
+        self.write_topic(topology)
+    }
+
+    /// Writes deformed positions on `/mesh/frame`.
+    pub fn write_frame(&mut self, frame: &MeshFrame) -> Result<(), TraceError> {
+        self.write_topic(frame)
+    }
+
+    /// Writes named scalar metrics on `/metrics`.
+    pub fn write_scalars(&mut self, scalars: &Scalars) -> Result<(), TraceError> {
+        self.write_topic(scalars)
+    }
+
+    /// Writes solver statistics on `/solver`.
+    pub fn write_solver_step(&mut self, step: &SolverStep) -> Result<(), TraceError> {
+        self.write_topic(step)
+    }
+
+    /// Writes the `yarnhom` metadata record (producer and free key/values). Usually written
+    /// once, first; MCAP closes the current chunk before a metadata record.
+    pub fn write_metadata(&mut self, metadata: &TraceMetadata) -> Result<(), TraceError> {
+        let record = metadata.to_record()?;
+        self.mcap().write_metadata(&record)?;
+        Ok(())
+    }
+
+    /// Closes the current chunk and flushes the output, so that a reader at the other end of a
+    /// pipe sees every message written so far. Frequent flushes make chunks smaller and
+    /// compression worse.
+    pub fn flush(&mut self) -> Result<(), TraceError> {
+        self.mcap().flush()?;
+        Ok(())
+    }
+
+    /// Completes the trace (last chunk, summary section, footer), flushes the output and, for
+    /// [`create`](Self::create), moves the file into place. Returns the output.
+    pub fn finish(mut self) -> Result<W, TraceError> {
+        let Some(mut mcap) = self.mcap.take() else {
+            unreachable!("the MCAP writer is only taken by finish() and drop()")
+        };
+        if let Err(err) = mcap.finish() {
+            // Skip the MCAP writer's own finish-on-drop: the trace is abandoned.
+            drop(mcap.into_inner());
+            return Err(err.into());
+        }
+        let mut out = mcap.into_inner();
+        out.flush()?;
+        if let Some(on_finish) = self.on_finish {
+            on_finish(&mut out)?;
+        }
+        Ok(out)
+    }
+
+    fn channel<T: Topic>(&mut self) -> Result<&mut ChannelState, TraceError> {
+        if !self.channels.contains_key(T::TOPIC) {
+            let schema =
+                serde_json::to_vec(&T::root_schema()).map_err(|source| TraceError::Schema {
+                    topic: T::TOPIC,
+                    source,
+                })?;
+            let metadata = BTreeMap::from([(TOPIC_VERSION_KEY.to_owned(), T::VERSION.to_string())]);
+            let mcap = self.mcap();
+            let schema_id = mcap.add_schema(T::SCHEMA_NAME, SCHEMA_ENCODING, &schema)?;
+            let id = mcap.add_channel(schema_id, T::TOPIC, MESSAGE_ENCODING, &metadata)?;
+            self.channels
+                .insert(T::TOPIC, ChannelState { id, count: 0 });
+        }
+        match self.channels.get_mut(T::TOPIC) {
+            Some(state) => Ok(state),
+            None => unreachable!("the channel was registered above"),
+        }
+    }
+
+    fn write_topic<T: Topic>(&mut self, message: &T) -> Result<(), TraceError> {
+        let log_time = match message.time_s() {
+            Some(time_s) => seconds_to_ns(T::TOPIC, time_s)?,
+            None => 0,
+        };
+        self.buf.clear();
+        rmp_serde::encode::write_named(&mut self.buf, message).map_err(|source| {
+            TraceError::Encode {
+                topic: T::TOPIC,
+                source,
+            }
+        })?;
+        let channel = self.channel::<T>()?;
+        // MCAP sequences are 32-bit: the frame number wraps (the message keeps all 64 bits).
+        let sequence = match message.frame() {
+            Some(frame) => frame as u32,
+            None => channel.count,
+        };
+        channel.count = channel.count.wrapping_add(1);
+        let header = MessageHeader {
+            channel_id: channel.id,
+            sequence,
+            log_time,
+            publish_time: log_time,
+        };
+        let Some(mcap) = self.mcap.as_mut() else {
+            unreachable!("the MCAP writer is only taken by finish() and drop()")
+        };
+        mcap.write_to_known_channel(&header, &self.buf)?;
+        Ok(())
+    }
+}
+
+impl<W: Write + Seek> Drop for TraceWriter<W> {
+    /// Abandons an unfinished trace without writing its summary (see [`TraceWriter`]).
+    fn drop(&mut self) {
+        if let Some(mcap) = self.mcap.take() {
+            drop(mcap.into_inner());
+        }
+    }
+}
+
+/// Converts simulated seconds to MCAP nanoseconds, rounding to the nearest nanosecond.
+fn seconds_to_ns(topic: &'static str, time_s: f64) -> Result<u64, TraceError> {
+    /// 2⁶⁴, the first value that no longer fits a `u64`.
+    const LIMIT: f64 = 18_446_744_073_709_551_616.0;
+    let ns = (time_s * 1e9).round();
+    if time_s.is_finite() && time_s >= 0.0 && ns < LIMIT {
+        // In range by the check above, so the cast is exact for the rounded value.
+        Ok(ns as u64)
+    } else {
+        Err(TraceError::InvalidTime { topic, time_s })
+    }
+}
+
+/// A trace file being written atomically by [`TraceWriter::create`].
+///
+/// Bytes go to a hidden temporary file next to the destination. [`TraceWriter::finish`] flushes
+/// it, syncs it to disk and renames it over the destination; if it is dropped before that, the
+/// temporary file is deleted.
+#[derive(Debug)]
+pub struct AtomicFile {
+    /// `None` once committed (or after a failed commit).
+    file: Option<BufWriter<File>>,
+    temp_path: PathBuf,
+    final_path: PathBuf,
+    committed: bool,
+}
+
+impl AtomicFile {
+    fn create(final_path: &Path) -> io::Result<Self> {
+        static COUNTER: AtomicU64 = AtomicU64::new(0);
+        let file_name = final_path.file_name().ok_or_else(|| {
+            io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!("trace path {} has no file name", final_path.display()),
+            )
+        })?;
+        let dir = match final_path.parent() {
+            Some(dir) if !dir.as_os_str().is_empty() => dir,
+            _ => Path::new("."),
+        };
+        loop {
+            let mut temp_name = OsString::from(".");
+            temp_name.push(file_name);
+            temp_name.push(format!(
+                ".{}-{}.tmp",
+                std::process::id(),
+                COUNTER.fetch_add(1, Ordering::Relaxed)
+            ));
+            let temp_path = dir.join(temp_name);
+            match OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&temp_path)
+            {
+                Ok(file) => {
+                    return Ok(Self {
+                        file: Some(BufWriter::new(file)),
+                        temp_path,
+                        final_path: final_path.to_path_buf(),
+                        committed: false,
+                    });
+                }
+                // A leftover from an earlier process with the same id: try the next name.
+                Err(err) if err.kind() == io::ErrorKind::AlreadyExists => continue,
+                Err(err) => return Err(err),
+            }
+        }
+    }
+
+    /// The destination path of the trace.
+    pub fn path(&self) -> &Path {
+        &self.final_path
+    }
+
+    /// Whether the trace has been moved into place.
+    pub fn is_committed(&self) -> bool {
+        self.committed
+    }
+
+    fn file(&mut self) -> io::Result<&mut BufWriter<File>> {
+        self.file
+            .as_mut()
+            .ok_or_else(|| io::Error::other("the trace file is already closed"))
+    }
+
+    /// Flushes, syncs and closes the temporary file, then renames it to the destination.
+    fn commit(&mut self) -> io::Result<()> {
+        let file = self
+            .file
+            .take()
+            .ok_or_else(|| io::Error::other("the trace file is already closed"))?;
+        let file = file.into_inner().map_err(io::IntoInnerError::into_error)?;
+        file.sync_all()?;
+        drop(file);
+        fs::rename(&self.temp_path, &self.final_path)?;
+        self.committed = true;
+        // Make the rename itself durable; some file systems refuse to sync a directory, and
+        // the trace is complete either way, so this is best effort.
+        #[cfg(unix)]
+        if let Some(dir) = self.final_path.parent() {
+            let dir = if dir.as_os_str().is_empty() {
+                Path::new(".")
+            } else {
+                dir
+            };
+            if let Ok(dir) = File::open(dir) {
+                let _ = dir.sync_all();
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.file()?.write(buf)
+    }
+
+    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
+        self.file()?.write_all(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        match self.file.as_mut() {
+            Some(file) => file.flush(),
+            None => Ok(()),
+        }
+    }
+}
+
+impl Seek for AtomicFile {
+    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        self.file()?.seek(pos)
+    }
+
+    fn stream_position(&mut self) -> io::Result<u64> {
+        self.file()?.stream_position()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if !self.committed {
+            // Close before deleting (required on Windows); errors cannot be reported here.
+            drop(self.file.take());
+            let _ = fs::remove_file(&self.temp_path);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn seconds_convert_to_rounded_nanoseconds() {
+        let ns = |t| seconds_to_ns("/t", t).ok();
+        assert_eq!(ns(0.0), Some(0));
+        assert_eq!(ns(-0.0), Some(0));
+        assert_eq!(ns(1.5), Some(1_500_000_000));
+        assert_eq!(ns(0.1), Some(100_000_000));
+        assert_eq!(ns(1e-10), Some(0));
+        assert_eq!(ns(18_000_000_000.0), Some(18_000_000_000_000_000_000));
+        assert_eq!(ns(-1e-12), None);
+        assert_eq!(ns(f64::NAN), None);
+        assert_eq!(ns(f64::INFINITY), None);
+        assert_eq!(ns(18_446_744_074.0), None);
+        let err = seconds_to_ns("/mesh/frame", -1.0).expect_err("negative time");
+        assert!(err.to_string().contains("/mesh/frame"), "{err}");
+    }
+}
