@@ -1,11 +1,24 @@
 //! Homogenized yarn-level cloth materials (thesis Ch. 4, App. A.3-A.5, B).
 //!
+//! - [`fit`]: a sampled grid into a spline material (Algorithms 3-5).
+//! - [`mls`]: moving least squares in symlog space (A.35).
+//! - [`monotone_cubic`], [`monotone_bicubic`]: monotone Hermite interpolation (Fritsch-Carlson
+//!   1980; App. B).
+//! - [`march`]: quasiconvex marching (A.36) and increasing extrapolation (A.3.5).
+//! - [`residual`]: residualization (A.37, A.38).
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
 //! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
 //! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
 
 pub mod curvature;
+pub mod fit;
 pub mod hermite;
+pub mod march;
 pub mod material;
+pub mod mls;
+pub mod monotone_bicubic;
+pub mod monotone_cubic;
+pub mod residual;
 
+pub use fit::{FitError, TermError, fit_errors, fit_grid};
 pub use material::{EnergyJet, SplineMaterial};

@@ -1,0 +1,315 @@
+//! Fitting a sampled grid into a spline material: Algorithm 3 with Algorithms 4 and 5 of the
+//! thesis (App. A.3): normalization, `f0`, MLS smoothing in symlog space (A.35), control points
+//! through the origin (A.3.2), quasiconvex marching (A.36), monotone cubic and bicubic
+//! interpolation (Fritsch-Carlson; App. B), increasing extrapolation (A.3.5) and residualization
+//! (A.37, A.38).
+
+use yarnhom_artifacts::grid::strain_values;
+use yarnhom_artifacts::{BicubicTerm, CubicTerm, FitSettings, Grid, GridTerm, Spline, SplineOrigin};
+
+use crate::march::{
+    bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d, quasiconvexify_1d,
+    zero_knot_index,
+};
+use crate::mls::{HermiteGrid, SmoothedEnergy1d, SmoothedEnergy2d};
+use crate::monotone_bicubic::make_monotone_bicubic;
+use crate::residual::{residualize_1d, residualize_2d, zero_compressed};
+
+/// The shear axis, symmetrized when [`FitSettings::symmetrize_shear`] (Sec. 4.3).
+const SHEAR: usize = 1;
+/// The pair `(sx, sy)` whose residual keeps its shape: no marching, no zeroed compression
+/// (A.3.4, A.3.6), so it carries the Poisson effect.
+const POISSON_PAIR: [usize; 2] = [0, 2];
+/// Fewest converged samples a term is fitted from.
+const MIN_SAMPLES: usize = 4;
+/// The MLS support spans at least this many of the widest gaps between sampled values, so a
+/// reduced plan still has enough data under every stencil.
+const RADIUS_IN_GAPS: f64 = 2.5;
+
+/// Why a grid cannot be fitted.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FitError {
+    /// The grid has no converged sample at zero strain, so `f0` is unknown.
+    #[error("the grid has no converged sample at zero strain (f0 = Ψ(0) is needed, Alg. 3 line 3)")]
+    NoRestSample,
+    /// A term has too few converged samples.
+    #[error("term {term} has {converged} converged samples; at least {MIN_SAMPLES} are needed")]
+    TooFewSamples {
+        /// The term's name.
+        term: String,
+        /// Converged samples.
+        converged: usize,
+    },
+    /// The smoothed energy is undefined at a control point (no data within the MLS radius).
+    #[error("term {term}: no data within the MLS radius of a control point; raise --mls-radius")]
+    NoSupport {
+        /// The term's name.
+        term: String,
+    },
+    /// A term's values do not include 0.
+    #[error("term {term}: its control points must include 0 (A.3.2)")]
+    NoZeroKnot {
+        /// The term's name.
+        term: String,
+    },
+}
+
+/// Fit a whole grid (Alg. 3). `areal_density_kg_m2` is the cloth's mass per area.
+pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -> Result<Spline, FitError> {
+    let scale = strain_scale(grid);
+    let mut terms_1d = Vec::new();
+    let mut terms_2d = Vec::new();
+    for (t, term) in grid.terms.iter().enumerate() {
+        let data = TermData::gather(grid, t, &scale)?;
+        match term.axes.as_slice() {
+            &[axis] => terms_1d.push(fit_1d(axis as usize, &data, settings)?),
+            &[u, v] => terms_2d.push(fit_2d([u as usize, v as usize], &data, settings)?),
+            _ => {}
+        }
+    }
+    Ok(Spline {
+        name: grid.pattern.clone(),
+        areal_density_kg_m2,
+        strain_scale: scale,
+        rest_energy_density_j_m2: rest_energy(grid).ok_or(FitError::NoRestSample)?,
+        terms_1d,
+        terms_2d,
+        origin: SplineOrigin::Fitted { settings: settings.clone() },
+    })
+}
+
+/// The normalization of each strain axis: its largest magnitude in the plan (Alg. 3 line 2);
+/// 1 for an axis the plan does not sample.
+pub fn strain_scale(grid: &Grid) -> [f64; 5] {
+    let mut scale = [0.0_f64; 5];
+    for term in &grid.terms {
+        for (&axis, values) in term.axes.iter().zip(&term.values) {
+            let largest = values.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            scale[axis as usize] = scale[axis as usize].max(largest);
+        }
+    }
+    scale.map(|s| if s > 0.0 { s } else { 1.0 })
+}
+
+/// `f0`: the energy density of a converged sample at zero strain.
+fn rest_energy(grid: &Grid) -> Option<f64> {
+    grid.samples
+        .iter()
+        .find(|s| s.converged && strain_values(&s.strain).iter().all(|&v| v == 0.0))
+        .and_then(|s| s.energy_density_j_m2)
+}
+
+/// A term's converged samples in normalized strain.
+struct TermData {
+    name: String,
+    /// Normalized strains along the term's axes (one list per axis, per sample).
+    strains: Vec<Vec<f64>>,
+    energies: Vec<f64>,
+    /// MLS radius for this term.
+    radius: f64,
+    /// Normalized sampled range `[min, max]` per axis.
+    ranges: Vec<[f64; 2]>,
+}
+
+impl TermData {
+    fn gather(grid: &Grid, t: usize, scale: &[f64; 5]) -> Result<Self, FitError> {
+        let term = &grid.terms[t];
+        let mut strains = vec![Vec::new(); term.axes.len()];
+        let mut energies = Vec::new();
+        for sample in grid.samples.iter().filter(|s| s.term as usize == t) {
+            let Some(energy) = sample.energy_density_j_m2.filter(|_| sample.converged) else { continue };
+            let values = strain_values(&sample.strain);
+            for (k, &axis) in term.axes.iter().enumerate() {
+                strains[k].push(values[axis as usize] / scale[axis as usize]);
+            }
+            energies.push(energy);
+        }
+        if energies.len() < MIN_SAMPLES {
+            return Err(FitError::TooFewSamples { term: term.name(), converged: energies.len() });
+        }
+        let ranges = normalized_ranges(term, scale);
+        let radius = mls_radius(term, scale);
+        Ok(Self { name: term.name(), strains, energies, radius, ranges })
+    }
+}
+
+fn normalized_ranges(term: &GridTerm, scale: &[f64; 5]) -> Vec<[f64; 2]> {
+    term.axes
+        .iter()
+        .zip(&term.values)
+        .map(|(&axis, values)| {
+            let s = scale[axis as usize];
+            [values[0] / s, values[values.len() - 1] / s]
+        })
+        .collect()
+}
+
+/// The larger of the configured radius and [`RADIUS_IN_GAPS`] widest gaps of the term's axes.
+fn mls_radius(term: &GridTerm, scale: &[f64; 5]) -> f64 {
+    let widest_gap = term
+        .axes
+        .iter()
+        .zip(&term.values)
+        .flat_map(|(&axis, values)| values.windows(2).map(move |w| (w[1] - w[0]) / scale[axis as usize]))
+        .fold(0.0_f64, f64::max);
+    RADIUS_IN_GAPS * widest_gap
+}
+
+/// Control points: two linearly spaced ranges left and right of 0 (A.3.2) spanning `span` of
+/// the sampled range `[min, max]`, `per_side` intervals each (a side of zero extent is omitted).
+pub fn control_points(range: [f64; 2], span: f64, per_side: usize) -> Vec<f64> {
+    let per_side = per_side.max(1);
+    let side = |end: f64| -> Vec<f64> {
+        if end == 0.0 {
+            return Vec::new();
+        }
+        (1..=per_side).map(|k| span * end * k as f64 / per_side as f64).collect()
+    };
+    let mut knots: Vec<f64> = side(range[0].min(0.0)).into_iter().rev().collect();
+    knots.push(0.0);
+    knots.extend(side(range[1].max(0.0)));
+    knots
+}
+
+/// Alg. 4: one 1D term.
+fn fit_1d(axis: usize, data: &TermData, settings: &FitSettings) -> Result<CubicTerm, FitError> {
+    let mut smoothed = SmoothedEnergy1d::new(&data.strains[0], &data.energies, data.radius.max(settings.mls_radius));
+    if axis == SHEAR && settings.symmetrize_shear {
+        smoothed = smoothed.symmetric();
+    }
+    let knots = control_points(data.ranges[0], settings.span_1d, settings.knots_per_side_1d as usize);
+    let (mut values, mut slopes) =
+        smoothed.hermite_data(&knots).ok_or_else(|| FitError::NoSupport { term: data.name.clone() })?;
+    let zero = zero_knot_index(&knots).ok_or_else(|| FitError::NoZeroKnot { term: data.name.clone() })?;
+    let i_min = if axis < 3 { zero } else { bending_minimum_index(&values) };
+    quasiconvexify_1d(&knots, &mut values, &mut slopes, i_min, settings.min_slope);
+    residualize_1d(&knots, &mut values).map_err(|_| FitError::NoZeroKnot { term: data.name.clone() })?;
+    Ok(CubicTerm { axis: axis as u8, knots, values, slopes })
+}
+
+/// Alg. 5: one 2D residual term over axes `[u, v]`.
+fn fit_2d(axes: [usize; 2], data: &TermData, settings: &FitSettings) -> Result<BicubicTerm, FitError> {
+    let no_support = || FitError::NoSupport { term: data.name.clone() };
+    let no_zero = || FitError::NoZeroKnot { term: data.name.clone() };
+    let span = if axes[1] >= 3 { settings.span_2d_bending } else { settings.span_2d };
+    let per_side = settings.knots_per_side_2d as usize;
+    let (u_knots, v_knots) =
+        (control_points(data.ranges[0], span, per_side), control_points(data.ranges[1], span, per_side));
+    let mut h = smoothed_hermite_2d(axes, data, settings, &u_knots, &v_knots).ok_or_else(no_support)?;
+    let i_min = zero_knot_index(&u_knots).ok_or_else(no_zero)?;
+    if axes == POISSON_PAIR {
+        // A.3.5: f13 is not marched; its boundary tangents are only made non-decreasing outward.
+        clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, 0.0);
+    } else {
+        let nu = u_knots.len();
+        let j_min = if axes[1] < 3 {
+            zero_knot_index(&v_knots).ok_or_else(no_zero)?
+        } else {
+            bending_minimum_row(&h.values, nu, i_min)
+        };
+        march_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv, i_min, j_min, settings.min_slope);
+        let min_slope = settings.min_slope;
+        clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, min_slope);
+    }
+    make_monotone_bicubic(&u_knots, &v_knots, &h.values, &mut h.du, &mut h.dv, &mut h.duv);
+    residualize_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv).map_err(|_| no_zero())?;
+    if axes != POISSON_PAIR {
+        let compressible = |axis: usize| axis == 0 || axis == 2;
+        let (cu, cv) = (compressible(axes[0]), compressible(axes[1]));
+        zero_compressed(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv, &mut h.duv, cu, cv);
+    }
+    Ok(BicubicTerm {
+        axes: [axes[0] as u8, axes[1] as u8],
+        u_knots,
+        v_knots,
+        values: h.values,
+        du: h.du,
+        dv: h.dv,
+        duv: h.duv,
+    })
+}
+
+/// Alg. 5 lines 2-9: MLS-smoothed Hermite data at the nodes, symmetrized in `sa` where it is
+/// one of the axes (the smoother symmetrizes its first argument, so `(sx, sa)` is smoothed
+/// transposed).
+fn smoothed_hermite_2d(
+    axes: [usize; 2],
+    data: &TermData,
+    settings: &FitSettings,
+    u_knots: &[f64],
+    v_knots: &[f64],
+) -> Option<HermiteGrid> {
+    let radius = data.radius.max(settings.mls_radius);
+    let (us, vs) = (&data.strains[0], &data.strains[1]);
+    let symmetric = settings.symmetrize_shear;
+    if symmetric && axes[1] == SHEAR {
+        let smoothed = SmoothedEnergy2d::new(vs, us, &data.energies, radius).symmetric_in_u();
+        return smoothed.hermite_data(v_knots, u_knots).map(|h| transpose(&h, v_knots.len(), u_knots.len()));
+    }
+    let mut smoothed = SmoothedEnergy2d::new(us, vs, &data.energies, radius);
+    if symmetric && axes[0] == SHEAR {
+        smoothed = smoothed.symmetric_in_u();
+    }
+    smoothed.hermite_data(u_knots, v_knots)
+}
+
+/// Nodal data of the transposed grid: `nu` nodes per row in the input become `nu` rows.
+fn transpose(h: &HermiteGrid, nu: usize, nv: usize) -> HermiteGrid {
+    let t = |a: &[f64]| (0..nu).flat_map(|i| (0..nv).map(move |j| a[j * nu + i])).collect::<Vec<_>>();
+    HermiteGrid { values: t(&h.values), du: t(&h.dv), dv: t(&h.du), duv: t(&h.duv) }
+}
+
+/// How well a spline reproduces the grid it was fitted to, per term.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TermError {
+    /// The term's name.
+    pub term: String,
+    /// Number of converged samples compared.
+    pub samples: usize,
+    /// RMS of (fit - data) over the term's samples divided by the RMS of the data (J/m²).
+    pub relative_rms: f64,
+    /// RMS of (fit - data) divided by the RMS of the deformation energy `data - f0`: the
+    /// stricter figure, blind to the constant.
+    pub relative_rms_deformation: f64,
+}
+
+/// The fit's error on each term of its grid.
+pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec<TermError> {
+    grid.terms
+        .iter()
+        .enumerate()
+        .map(|(t, term)| {
+            let pairs: Vec<(f64, f64)> = grid
+                .samples
+                .iter()
+                .filter(|s| s.term as usize == t && s.converged)
+                .filter_map(|s| s.energy_density_j_m2.map(|e| (material.energy_at(&s.strain), e)))
+                .collect();
+            let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
+                (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt()
+            };
+            let error = rms(&|(fit, data)| fit - data);
+            TermError {
+                term: term.name(),
+                samples: pairs.len(),
+                relative_rms: error / rms(&|(_, data)| *data),
+                relative_rms_deformation: error / rms(&|(_, data)| data - f0),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_points_include_zero_and_span_the_range() {
+        let knots = control_points([-0.3, 0.8], 0.95, 5);
+        assert_eq!(knots.len(), 11);
+        assert_eq!(knots[5], 0.0);
+        assert!((knots[0] + 0.95 * 0.3).abs() < 1e-15 && (knots[10] - 0.95 * 0.8).abs() < 1e-15);
+        assert!(knots.windows(2).all(|w| w[0] < w[1]));
+        assert_eq!(control_points([0.0, 1.0], 0.9, 4), vec![0.0, 0.225, 0.45, 0.675, 0.9]);
+    }
+}
