@@ -1,0 +1,251 @@
+//! The elastic energy of a cloth mesh: per triangle `A Ψ(I, II)` over its stencil (4.8) with the
+//! derivative split of App. A.5 and per-element eigenvalue clamping to positive semidefinite
+//! Hessians (Sec. 4.2, after Teran et al. 2005), plus per-hinge bending (6.4) where the material
+//! has it.
+
+use nalgebra::{SMatrix, SVector, Vector3};
+use rayon::prelude::*;
+
+use crate::forms::{RestTriangle, Stencil, forms, forms_with_derivatives};
+use crate::hinge::{HingeRest, anisotropic_stiffness, hinge_energy, hinge_energy_with_derivatives};
+use crate::material::ShellMaterial;
+use crate::mesh::ShellMesh;
+
+/// Energy, gradient and (lower-triangle) Hessian triplets of some energy over all DOFs.
+#[derive(Debug, Clone, Default)]
+pub struct Assembly {
+    /// Energy (J).
+    pub energy: f64,
+    /// Gradient over the `3 n` DOFs (N).
+    pub gradient: Vec<f64>,
+    /// Hessian entries `(row, col, value)`, `row >= col`, duplicates to be summed (N/m).
+    pub triplets: Vec<(usize, usize, f64)>,
+}
+
+impl Assembly {
+    /// An empty assembly over `dofs` degrees of freedom.
+    pub fn new(dofs: usize) -> Self {
+        Self { energy: 0.0, gradient: vec![0.0; dofs], triplets: Vec::new() }
+    }
+
+    /// Add an element's energy, gradient and Hessian over the vertices `vertices` (absent
+    /// vertices contribute nothing).
+    pub fn add_element<const N: usize>(
+        &mut self,
+        vertices: &[Option<u32>],
+        energy: f64,
+        gradient: &SVector<f64, N>,
+        hessian: Option<&SMatrix<f64, N, N>>,
+    ) {
+        self.energy += energy;
+        for (a, va) in vertices.iter().enumerate() {
+            let Some(va) = va else { continue };
+            for k in 0..3 {
+                self.gradient[3 * *va as usize + k] += gradient[3 * a + k];
+            }
+            let Some(h) = hessian else { continue };
+            for (b, vb) in vertices.iter().enumerate() {
+                let Some(vb) = vb else { continue };
+                for k in 0..3 {
+                    for l in 0..3 {
+                        let (row, col) = (3 * *va as usize + k, 3 * *vb as usize + l);
+                        if row >= col {
+                            self.triplets.push((row, col, h[(3 * a + k, 3 * b + l)]));
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Clamp the eigenvalues of a symmetric element Hessian to be non-negative. Matrices that are
+/// already positive semidefinite (a Cholesky factorization of `H + ε I` succeeds, `ε` at
+/// rounding level) are returned untouched, skipping the eigensolver.
+pub fn project_psd<const N: usize>(h: SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+    let scale = h.diagonal().amax().max(f64::MIN_POSITIVE);
+    let shifted = h + SMatrix::<f64, N, N>::identity() * (1e-12 * scale);
+    if nalgebra::Cholesky::new(shifted).is_some() {
+        return h;
+    }
+    // The eigensolver is generic over dimensions fixed by type-level numbers, not const
+    // generics, so the (rarer) indefinite case goes through a dynamic matrix.
+    let mut eigen = nalgebra::SymmetricEigen::new(nalgebra::DMatrix::from_column_slice(N, N, h.as_slice()));
+    eigen.eigenvalues.iter_mut().for_each(|l| *l = l.max(0.0));
+    SMatrix::<f64, N, N>::from_column_slice(eigen.recompose().as_slice())
+}
+
+/// A cloth's elastic energy: mesh, rest data and material.
+#[derive(Debug, Clone)]
+pub struct ElasticModel {
+    /// The mesh.
+    pub mesh: ShellMesh,
+    /// The material.
+    pub material: ShellMaterial,
+    rest: Vec<RestTriangle>,
+    hinges: Vec<HingeRest>,
+}
+
+/// An element's energy with gradient and projected Hessian.
+type Element<const N: usize> = (f64, SVector<f64, N>, Option<SMatrix<f64, N, N>>);
+
+impl ElasticModel {
+    /// The model of `mesh` made of `material`, rest state flat at the material coordinates.
+    pub fn new(mesh: ShellMesh, material: ShellMaterial) -> Self {
+        let rest = mesh.triangles.iter().map(|t| RestTriangle::new(&t.map(|v| mesh.material[v as usize]))).collect();
+        let hinges = match material.hinge_bending {
+            Some(k) => mesh
+                .hinges
+                .iter()
+                .map(|h| {
+                    let m = h.vertices.map(|v| mesh.material[v as usize]);
+                    HingeRest::new(&m, anisotropic_stiffness(&(m[1] - m[0]), k.k_weft, k.k_bias, k.k_warp))
+                })
+                .collect(),
+            None => Vec::new(),
+        };
+        Self { mesh, material, rest, hinges }
+    }
+
+    /// The stencil vertices of triangle `t`: its 3 vertices and the 3 far neighbours.
+    fn stencil_vertices(&self, t: usize) -> [Option<u32>; 6] {
+        let [a, b, c] = self.mesh.triangles[t];
+        let [n0, n1, n2] = self.mesh.neighbours[t];
+        [Some(a), Some(b), Some(c), n0, n1, n2]
+    }
+
+    fn stencil(&self, t: usize, x: &[Vector3<f64>]) -> Stencil {
+        let [a, b, c] = self.mesh.triangles[t];
+        Stencil {
+            triangle: [a, b, c].map(|v| x[v as usize]),
+            neighbours: self.mesh.neighbours[t].map(|n| n.map(|v| x[v as usize])),
+        }
+    }
+
+    /// The discrete forms `(I, II)` of triangle `t`.
+    pub fn triangle_forms(&self, t: usize, x: &[Vector3<f64>]) -> ([f64; 3], [f64; 3]) {
+        forms(&self.rest[t], &self.stencil(t, x))
+    }
+
+    /// The elastic energy (J).
+    pub fn energy(&self, x: &[Vector3<f64>]) -> f64 {
+        let triangles: f64 = (0..self.rest.len())
+            .into_par_iter()
+            .map(|t| {
+                let (first, second) = self.triangle_forms(t, x);
+                self.rest[t].rest_area * self.material.energy_density(first, second)
+            })
+            .collect::<Vec<_>>()
+            .iter()
+            .sum();
+        let hinges: f64 = self
+            .hinges
+            .iter()
+            .zip(&self.mesh.hinges)
+            .map(|(rest, h)| hinge_energy(rest, &h.vertices.map(|v| x[v as usize])))
+            .sum();
+        triangles + hinges
+    }
+
+    /// Energy, gradient and, if `hessian`, the clamped Hessian, added into `out`. Elements are
+    /// evaluated in parallel and summed in element order (identical for any thread count).
+    pub fn assemble(&self, x: &[Vector3<f64>], hessian: bool, out: &mut Assembly) {
+        let triangles: Vec<Element<18>> =
+            (0..self.rest.len()).into_par_iter().map(|t| self.triangle_element(t, x, hessian)).collect();
+        for (t, (e, g, h)) in triangles.iter().enumerate() {
+            out.add_element(&self.stencil_vertices(t), *e, g, h.as_ref());
+        }
+        let hinges: Vec<Element<12>> = self
+            .hinges
+            .par_iter()
+            .zip(&self.mesh.hinges)
+            .map(|(rest, h)| {
+                let d = hinge_energy_with_derivatives(rest, &h.vertices.map(|v| x[v as usize]));
+                (d.energy, d.gradient, hessian.then(|| project_psd(d.hessian)))
+            })
+            .collect();
+        for ((e, g, h), hinge) in hinges.iter().zip(&self.mesh.hinges) {
+            out.add_element(&hinge.vertices.map(Some), *e, g, h.as_ref());
+        }
+    }
+
+    /// (4.8) with (A.43)-(A.44): `E = A Ψ(z(q))`, `∇E = A Jᵀ ∇Ψ`,
+    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂z_k ∇² z_k)`, clamped to PSD.
+    fn triangle_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> Element<18> {
+        let rest = &self.rest[t];
+        let forms = forms_with_derivatives(rest, &self.stencil(t, x));
+        let jet = self.material.jet(forms.first, forms.second);
+        let area = rest.rest_area;
+        let gradient = area * forms.gradient.transpose() * jet.gradient;
+        let h = hessian.then(|| {
+            let mut h = forms.gradient.transpose() * jet.hessian * forms.gradient;
+            for (k, d2z) in forms.hessian.iter().enumerate() {
+                if jet.gradient[k] != 0.0 {
+                    h += jet.gradient[k] * d2z;
+                }
+            }
+            project_psd(area * h)
+        });
+        (area * jet.value, gradient, h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::{HingeBending, StvkNeoHookean};
+
+    fn stvk() -> ShellMaterial {
+        ShellMaterial::stvk(
+            0.3,
+            StvkNeoHookean { k_xx: 3.0, k_xy: 0.5, k_yy: 1.0, k_ss: 0.7, k_n1: 0.2, k_n2: 0.1 },
+            HingeBending { k_weft: 1e-4, k_bias: 2e-4, k_warp: 3e-4 },
+        )
+    }
+
+    fn deformed(mesh: &ShellMesh) -> Vec<Vector3<f64>> {
+        mesh.material
+            .iter()
+            .map(|m| Vector3::new(1.1 * m.x + 0.05 * m.y, 0.95 * m.y, 0.3 * (3.0 * m.x).sin() * m.y))
+            .collect()
+    }
+
+    #[test]
+    fn assembled_gradient_matches_finite_differences_of_the_energy() {
+        let mesh = ShellMesh::rectangle(0.3, 0.2, 4, 3).expect("mesh");
+        let model = ElasticModel::new(mesh.clone(), stvk());
+        let x = deformed(&mesh);
+        let mut a = Assembly::new(3 * x.len());
+        model.assemble(&x, false, &mut a);
+        assert!((a.energy - model.energy(&x)).abs() < 1e-12 * a.energy.abs().max(1.0));
+        let h = 1e-7;
+        for dof in 0..3 * x.len() {
+            let (mut p, mut m) = (x.clone(), x.clone());
+            p[dof / 3][dof % 3] += h;
+            m[dof / 3][dof % 3] -= h;
+            let fd = (model.energy(&p) - model.energy(&m)) / (2.0 * h);
+            assert!((a.gradient[dof] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "dof {dof}: {} vs {fd}", a.gradient[dof]);
+        }
+    }
+
+    #[test]
+    fn rigid_motions_leave_the_energy_unchanged() {
+        let mesh = ShellMesh::rectangle(0.3, 0.2, 4, 3).expect("mesh");
+        let model = ElasticModel::new(mesh.clone(), stvk());
+        let x = deformed(&mesh);
+        let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+        let moved: Vec<_> = x.iter().map(|p| rotation * p + Vector3::new(1.0, -2.0, 0.5)).collect();
+        assert!((model.energy(&x) - model.energy(&moved)).abs() < 1e-12);
+        assert!(model.energy(&mesh.flat_positions()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn projected_hessians_are_psd_and_psd_ones_are_untouched() {
+        let a = SMatrix::<f64, 3, 3>::new(2.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.5);
+        let p = project_psd(a);
+        assert!(p.symmetric_eigenvalues().iter().all(|&l| l >= -1e-15));
+        assert!((p[(1, 1)]).abs() < 1e-15 && (p[(0, 0)] - 2.0).abs() < 1e-15);
+        let spd = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0);
+        assert_eq!(project_psd(spd), spd);
+    }
+}

@@ -1,0 +1,20 @@
+//! yarnhom's thin-shell cloth simulator (thesis Sec. 4.2, Ch. 6).
+//!
+//! - [`mesh`]: cloth triangle meshes and their adjacency.
+//! - [`forms`], [`dihedral`], [`hinge`]: discrete fundamental forms (4.4)-(4.7) and the edge
+//!   bending (6.4), with exact derivatives.
+//! - [`material`]: spline materials (Ch. 4) and anisotropic StVK + Neo-Hookean (6.1).
+//! - [`elastic`]: per-element energies, the derivative split (A.43)-(A.44), PSD clamping.
+
+pub mod dihedral;
+pub mod elastic;
+pub mod forms;
+pub mod hinge;
+pub mod material;
+pub mod mesh;
+#[cfg(test)]
+mod test_support;
+
+pub use elastic::{Assembly, ElasticModel};
+pub use material::{HingeBending, ShellMaterial, StvkNeoHookean};
+pub use mesh::ShellMesh;

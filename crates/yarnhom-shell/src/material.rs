@@ -1,0 +1,162 @@
+//! Shell materials: an energy density of the discrete fundamental forms (the membrane-and-
+//! bending part, evaluated per triangle (4.8)) and an optional edge-hinge bending energy (6.4).
+//!
+//! - [`ShellMaterial::spline`]: the homogenized yarn-level material of Ch. 4 (a
+//!   [`SplineMaterial`] fitted by `yarnhom fit` or imported from ARCSim-HYLC).
+//! - [`ShellMaterial::stvk`]: the Ch. 6 anisotropic StVK with a Neo-Hookean area term (6.1),
+//!   with the anisotropic edge bending (6.4).
+
+use nalgebra::{Matrix3, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
+use yarnhom_fit::{EnergyJet, SplineMaterial};
+
+/// The (6.1) parameters (J/m²): `k_xx, k_xy, k_yy, k_ss` of the StVK stiffness matrix on the
+/// Voigt Green strain `(E11, E22, 2 E12)`, and the Neo-Hookean area terms `k_n1 (J-1)²` and
+/// `k_n2 log² J`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct StvkNeoHookean {
+    /// Weft stiffness.
+    pub k_xx: f64,
+    /// Weft-warp coupling.
+    pub k_xy: f64,
+    /// Warp stiffness.
+    pub k_yy: f64,
+    /// Shear stiffness.
+    pub k_ss: f64,
+    /// `(J - 1)²` weight.
+    pub k_n1: f64,
+    /// `log² J` weight.
+    pub k_n2: f64,
+}
+
+/// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct HingeBending {
+    /// Bending that curves the weft (X) direction.
+    pub k_weft: f64,
+    /// Bending at 45°.
+    pub k_bias: f64,
+    /// Bending that curves the warp (Y) direction.
+    pub k_warp: f64,
+}
+
+/// The energy density of the forms.
+#[derive(Debug, Clone)]
+pub enum FormsEnergy {
+    /// A homogenized spline material (4.3), (A.34): membrane and bending.
+    Spline(Box<SplineMaterial>),
+    /// Anisotropic StVK + Neo-Hookean (6.1): membrane only.
+    Stvk(StvkNeoHookean),
+}
+
+/// A cloth material: mass, the energy density of the forms, optional hinge bending.
+#[derive(Debug, Clone)]
+pub struct ShellMaterial {
+    /// Areal mass density (kg/m²).
+    pub areal_density_kg_m2: f64,
+    /// The per-triangle energy density.
+    pub forms: FormsEnergy,
+    /// The per-edge bending energy (6.4), if any.
+    pub hinge_bending: Option<HingeBending>,
+}
+
+impl ShellMaterial {
+    /// A spline material with its own areal density.
+    pub fn spline(material: SplineMaterial) -> Self {
+        Self {
+            areal_density_kg_m2: material.areal_density_kg_m2(),
+            forms: FormsEnergy::Spline(Box::new(material)),
+            hinge_bending: None,
+        }
+    }
+
+    /// The Ch. 6 model: (6.1) membrane and (6.4) bending.
+    pub fn stvk(areal_density_kg_m2: f64, membrane: StvkNeoHookean, bending: HingeBending) -> Self {
+        Self { areal_density_kg_m2, forms: FormsEnergy::Stvk(membrane), hinge_bending: Some(bending) }
+    }
+
+    /// The energy density (J/m²) with derivatives in `(I11, I12, I22, II11, II12, II22)`.
+    pub fn jet(&self, first: [f64; 3], second: [f64; 3]) -> EnergyJet {
+        match &self.forms {
+            FormsEnergy::Spline(m) => m.jet(first, second),
+            FormsEnergy::Stvk(m) => m.jet(first),
+        }
+    }
+
+    /// The energy density only.
+    pub fn energy_density(&self, first: [f64; 3], second: [f64; 3]) -> f64 {
+        match &self.forms {
+            FormsEnergy::Spline(m) => m.energy_density(first, second),
+            FormsEnergy::Stvk(m) => m.jet(first).value,
+        }
+    }
+
+    /// Whether the forms energy depends on `II` (else the bending comes from hinges only).
+    pub fn uses_second_form(&self) -> bool {
+        matches!(self.forms, FormsEnergy::Spline(_))
+    }
+}
+
+impl StvkNeoHookean {
+    /// (6.1) with derivatives in `(I11, I12, I22, ·, ·, ·)` (no dependence on `II`).
+    pub fn jet(&self, first: [f64; 3]) -> EnergyJet {
+        let [a, b, c] = first;
+        // Voigt Green strain ε = ((I11 - 1)/2, (I22 - 1)/2, I12), linear in I.
+        let eps = Vector3::new(0.5 * (a - 1.0), 0.5 * (c - 1.0), b);
+        let d_eps = Matrix3::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0);
+        let k = Matrix3::new(self.k_xx, self.k_xy, 0.0, self.k_xy, self.k_yy, 0.0, 0.0, 0.0, self.k_ss);
+        let stvk_gradient = d_eps.transpose() * k * eps;
+        let stvk_hessian = d_eps.transpose() * k * d_eps;
+        // J = sqrt(det I).
+        let det = a * c - b * b;
+        let j = det.max(1e-300).sqrt();
+        let d_det = Vector3::new(c, -2.0 * b, a);
+        let dd_det = Matrix3::new(0.0, 0.0, 1.0, 0.0, -2.0, 0.0, 1.0, 0.0, 0.0);
+        let d_j = d_det / (2.0 * j);
+        let dd_j = dd_det / (2.0 * j) - d_det * d_det.transpose() / (4.0 * j * j * j);
+        let log_j = j.ln();
+        let g = self.k_n1 * (j - 1.0).powi(2) + self.k_n2 * log_j * log_j;
+        let dg = 2.0 * self.k_n1 * (j - 1.0) + 2.0 * self.k_n2 * log_j / j;
+        let ddg = 2.0 * self.k_n1 + 2.0 * self.k_n2 * (1.0 - log_j) / (j * j);
+        let gradient = stvk_gradient + dg * d_j;
+        let hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
+        let mut jet = EnergyJet { value: 0.5 * eps.dot(&(k * eps)) + g, gradient: Vector6::zeros(), hessian: Default::default() };
+        jet.gradient.fixed_rows_mut::<3>(0).copy_from(&gradient);
+        jet.hessian.fixed_view_mut::<3, 3>(0, 0).copy_from(&hessian);
+        jet
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stvk_derivatives_match_finite_differences_and_rest_is_stress_free() {
+        let m = StvkNeoHookean { k_xx: 3.0, k_xy: 0.5, k_yy: 1.0, k_ss: 0.7, k_n1: 0.2, k_n2: 0.1 };
+        let rest = m.jet([1.0, 0.0, 1.0]);
+        assert!(rest.value.abs() < 1e-15 && rest.gradient.norm() < 1e-15);
+        let first = [1.3, 0.2, 0.9];
+        let jet = m.jet(first);
+        let h = 1e-6;
+        for j in 0..3 {
+            let (mut p, mut q) = (first, first);
+            p[j] += h;
+            q[j] -= h;
+            let (jp, jq) = (m.jet(p), m.jet(q));
+            assert!((jet.gradient[j] - (jp.value - jq.value) / (2.0 * h)).abs() < 1e-7);
+            for i in 0..3 {
+                assert!((jet.hessian[(i, j)] - (jp.gradient[i] - jq.gradient[i]) / (2.0 * h)).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn the_area_term_resists_inversion() {
+        // Uniaxial compression of an isotropic StVK sheet: the Neo-Hookean log term grows
+        // without bound as the area vanishes (Fig. 6.5).
+        let m = StvkNeoHookean { k_xx: 1.0, k_xy: 0.0, k_yy: 1.0, k_ss: 1.0, k_n1: 0.0, k_n2: 0.1 };
+        let energy = |s: f64| m.jet([s * s, 0.0, 1.0]).value;
+        assert!(energy(1e-3) > energy(0.1) && energy(0.1) > energy(0.5));
+    }
+}
