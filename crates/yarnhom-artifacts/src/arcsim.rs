@@ -87,9 +87,9 @@ fn format_error(line: usize, message: impl Into<String>) -> Error {
 }
 
 impl ArcsimMaterial {
-    /// Parse the JSON text of a material (ARCSim's JSON allows `//` comments; so do we).
+    /// Parse the JSON text of a material (ARCSim's JSON allows `//` and `/* */` comments; so do we).
     pub fn parse(text: &str) -> Result<Self> {
-        let text = strip_line_comments(text);
+        let text = strip_comments(text);
         let material: Self =
             serde_json::from_str(&text).map_err(|e| format_error(e.line(), e.to_string()))?;
         if material.strain_shift != STRAIN_SHIFT {
@@ -179,30 +179,43 @@ pub fn read_spline(path: &std::path::Path) -> Result<Spline> {
     ArcsimMaterial::parse(&text).and_then(|m| m.to_spline(stem, file)).map_err(|e| e.at(path))
 }
 
-/// Remove `//` comments outside strings (ARCSim's JSON dialect).
-pub fn strip_line_comments(text: &str) -> String {
+/// Remove `//` line comments and `/* */` block comments outside strings (ARCSim's JSON
+/// dialect); line breaks are kept so parse errors keep their line numbers.
+pub fn strip_comments(text: &str) -> String {
     let mut out = String::with_capacity(text.len());
-    for line in text.lines() {
-        let mut in_string = false;
-        let mut escaped = false;
-        let mut cut = line.len();
-        let bytes = line.as_bytes();
-        for (i, &b) in bytes.iter().enumerate() {
-            match b {
-                b'\\' if in_string => escaped = !escaped,
-                b'"' if !escaped => in_string = !in_string,
-                b'/' if !in_string && bytes.get(i + 1) == Some(&b'/') => {
-                    cut = i;
-                    break;
+    let mut chars = text.chars().peekable();
+    let (mut in_string, mut escaped) = (false, false);
+    while let Some(c) = chars.next() {
+        if in_string {
+            out.push(c);
+            escaped = c == '\\' && !escaped;
+            in_string = !(c == '"' && !escaped);
+            continue;
+        }
+        match (c, chars.peek()) {
+            ('/', Some('/')) => {
+                while chars.peek().is_some_and(|&n| n != '\n') {
+                    chars.next();
                 }
-                _ => escaped = false,
             }
-            if b != b'\\' {
-                escaped = false;
+            ('/', Some('*')) => {
+                chars.next();
+                let mut last = ' ';
+                for n in chars.by_ref() {
+                    if n == '\n' {
+                        out.push('\n');
+                    }
+                    if last == '*' && n == '/' {
+                        break;
+                    }
+                    last = n;
+                }
+            }
+            _ => {
+                in_string = c == '"';
+                out.push(c);
             }
         }
-        out.push_str(&line[..cut]);
-        out.push('\n');
     }
     out
 }
@@ -224,7 +237,9 @@ mod tests {
 
     const FIT: &str = r#"{"density": 0.3, "strain scale": [0.5, 1, 1, 1, 1], "strain shift": [1, 0, 1, 0, 0],
         "coeffs": {"const": 0.1,
-        "1D": [{"k": 0, "t": [0, 1, 2], "p": [0, 1, 4], "m": [0, 2, 4]}], // a comment
+        "1D": [{"k": 0, "t": [0, 1, 2], "p": [0, 1, 4], "m": [0, 2, 4]}], // a comment "with quotes"
+        /* a block
+           comment */
         "2D": [{"k0": 0, "k1": 3, "tu": [0, 1], "tv": [0, 1, 2], "p": [0,0,0,0,0,1], "mu": [0,0,0,0,0,0], "mv": [0,0,0,0,0,0], "muv": [0,0,0,0,0,0]}]}}"#;
 
     #[test]

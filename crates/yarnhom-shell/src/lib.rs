@@ -5,16 +5,25 @@
 //!   bending (6.4), with exact derivatives.
 //! - [`material`]: spline materials (Ch. 4) and anisotropic StVK + Neo-Hookean (6.1).
 //! - [`elastic`]: per-element energies, the derivative split (A.43)-(A.44), PSD clamping.
+//! - [`contact`]: obstacles, friction and self-collision.
+//! - [`scene`], [`arcsim_scene`]: scene files, built-ins and the published ARCSim scenes.
+//! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping.
 
+pub mod arcsim_scene;
+pub mod contact;
 pub mod dihedral;
 pub mod elastic;
 pub mod forms;
 pub mod hinge;
+pub mod integrator;
 pub mod material;
 pub mod mesh;
+pub mod scene;
 #[cfg(test)]
 mod test_support;
 
 pub use elastic::{Assembly, ElasticModel};
+pub use integrator::{Dynamics, Handle, Motion, Simulation, StepStats};
 pub use material::{HingeBending, ShellMaterial, StvkNeoHookean};
 pub use mesh::ShellMesh;
+pub use scene::Scene;

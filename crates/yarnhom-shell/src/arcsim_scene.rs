@@ -1,0 +1,150 @@
+//! ARCSim-HYLC scene files (`../shared/data/hylc-scenes/*.json`) read into a [`Scene`]: the
+//! cloth square (`hylc_square.obj`, a unit square, scaled), handlebars, handlespheres, their
+//! keyframed translations, sphere obstacles (`sphere.obj`, a unit sphere, scaled), gravity,
+//! obstacle friction, the repulsion thickness and the material's stiffness damping.
+//!
+//! Not carried over: ARCSim's adaptive remeshing (we use a fixed mesh of the built-in
+//! resolution), its 80 substeps per frame (we take [`Scene::steps_per_frame`] implicit steps)
+//! and its wind drag (we use Rayleigh mass damping).
+
+use serde_json::Value;
+
+use crate::contact::Obstacle;
+use crate::scene::{HandleSpec, Scene, SceneError};
+
+fn number(v: &Value, key: &str) -> Option<f64> {
+    v.get(key).and_then(Value::as_f64)
+}
+
+fn triple(v: Option<&Value>) -> Option<[f64; 3]> {
+    let a = v?.as_array()?;
+    Some([a.first()?.as_f64()?, a.get(1)?.as_f64()?, a.get(2)?.as_f64()?])
+}
+
+fn invalid(name: &str, problem: impl Into<String>) -> SceneError {
+    SceneError::Invalid { scene: name.into(), problem: problem.into() }
+}
+
+/// The scene of a parsed ARCSim JSON document named `name`.
+pub fn import(doc: &Value, name: &str) -> Result<Scene, SceneError> {
+    let mut scene = Scene::builtin("stretch-x")?;
+    scene.name = name.into();
+    scene.handles.clear();
+    scene.motions.clear();
+    let cloth = doc.get("cloths").and_then(|c| c.get(0)).ok_or_else(|| invalid(name, "no cloth"))?;
+    let scale = cloth.pointer("/transform/scale").and_then(Value::as_f64).unwrap_or(1.0);
+    scene.size_m = [scale, scale];
+    if let Some(d) = cloth.pointer("/materials/0/damping").and_then(Value::as_f64) {
+        scene.stiffness_damping = d;
+    }
+    scene.end_time_s = number(doc, "end_time").unwrap_or(scene.end_time_s);
+    scene.frame_time_s = number(doc, "frame_time").unwrap_or(scene.frame_time_s);
+    scene.gravity = triple(doc.get("gravity")).unwrap_or(scene.gravity);
+    scene.contact.friction = number(doc, "obs_friction").unwrap_or(0.0);
+    if let Some(t) = doc.pointer("/magic/repulsion_thickness").and_then(Value::as_f64) {
+        scene.contact.thickness_m = t;
+    }
+    scene.motions = motions(doc, name)?;
+    scene.handles = handles(doc, name)?;
+    scene.obstacles = obstacles(doc, name)?;
+    if !scene.obstacles.is_empty() {
+        scene.contact.self_thickness_m = 6e-3;
+        scene.contact.self_stiffness_n_m = 10.0;
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+fn motions(doc: &Value, name: &str) -> Result<Vec<Vec<(f64, [f64; 3])>>, SceneError> {
+    let Some(list) = doc.get("motions").and_then(Value::as_array) else { return Ok(Vec::new()) };
+    list.iter()
+        .map(|motion| {
+            motion
+                .as_array()
+                .ok_or_else(|| invalid(name, "a motion is not a list of keyframes"))?
+                .iter()
+                .map(|key| {
+                    let time = number(key, "time").ok_or_else(|| invalid(name, "a keyframe has no time"))?;
+                    let shift = triple(key.pointer("/transform/translate")).unwrap_or([0.0; 3]);
+                    Ok((time, shift))
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn handles(doc: &Value, name: &str) -> Result<Vec<HandleSpec>, SceneError> {
+    let motion = |h: &Value| h.get("motion").and_then(Value::as_u64).map(|m| m as usize);
+    let mut out = Vec::new();
+    for h in doc.get("handlebars").and_then(Value::as_array).into_iter().flatten() {
+        out.push(HandleSpec::Bar {
+            side: h.get("side").and_then(Value::as_u64).ok_or_else(|| invalid(name, "handlebar without side"))? as u8,
+            length: number(h, "lengthp").unwrap_or(1.0),
+            width: number(h, "widthp").unwrap_or(0.05),
+            inset: number(h, "insetp").unwrap_or(0.0),
+            motion: motion(h),
+        });
+    }
+    for h in doc.get("handlespheres").and_then(Value::as_array).into_iter().flatten() {
+        out.push(HandleSpec::Sphere {
+            center: triple(h.get("center")).ok_or_else(|| invalid(name, "handlesphere without center"))?,
+            radius: number(h, "radius").ok_or_else(|| invalid(name, "handlesphere without radius"))?,
+            motion: motion(h),
+        });
+    }
+    Ok(out)
+}
+
+fn obstacles(doc: &Value, name: &str) -> Result<Vec<Obstacle>, SceneError> {
+    let mut out = Vec::new();
+    for o in doc.get("obstacles").and_then(Value::as_array).into_iter().flatten() {
+        let mesh = o.get("mesh").and_then(Value::as_str).unwrap_or("");
+        if !mesh.ends_with("sphere.obj") {
+            return Err(invalid(name, format!("obstacle mesh '{mesh}' is not supported (only sphere.obj)")));
+        }
+        out.push(Obstacle::Sphere {
+            center: triple(o.pointer("/transform/translate")).unwrap_or([0.0; 3]),
+            radius: o.pointer("/transform/scale").and_then(Value::as_f64).unwrap_or(1.0),
+        });
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn published(file: &str) -> Scene {
+        let path = format!("{}/../../../shared/data/hylc-scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+        Scene::load(&path).expect("published scene imports")
+    }
+
+    #[test]
+    fn the_builtins_equal_the_published_stockinette_scenes() {
+        // Same handles, motions, obstacles, times and contact thickness as the files.
+        for (file, builtin) in [("stock_stretchX.json", "stretch-x"), ("stock_stretchY.json", "stretch-y"), ("stock_drapeX.json", "drape")] {
+            let (a, b) = (published(file), Scene::builtin(builtin).expect("builtin"));
+            assert_eq!(a.handles, b.handles, "{file}");
+            assert_eq!(a.motions, b.motions, "{file}");
+            assert_eq!(a.obstacles, b.obstacles, "{file}");
+            assert_eq!((a.end_time_s, a.frame_time_s, a.size_m), (b.end_time_s, b.frame_time_s, b.size_m), "{file}");
+            assert_eq!(a.contact.thickness_m, b.contact.thickness_m, "{file}");
+        }
+    }
+
+    #[test]
+    fn every_published_scene_imports() {
+        let dir = format!("{}/../../../shared/data/hylc-scenes", env!("CARGO_MANIFEST_DIR"));
+        let mut count = 0;
+        for entry in std::fs::read_dir(dir).expect("published scenes").flatten() {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            if name.ends_with(".json") {
+                let scene = published(&name);
+                assert!(!scene.handles.is_empty(), "{name}");
+                assert!(scene.handles(&scene.mesh()).is_ok(), "{name}");
+                count += 1;
+            }
+        }
+        assert_eq!(count, 20);
+    }
+}

@@ -1,0 +1,413 @@
+//! Implicit Euler time stepping as minimization of the incremental potential (Sec. 4.2): each
+//! step minimizes
+//!
+//! `Φ(x) = Σ m_i |x_i - x̂_i|² / (2h²) + E(x) + E_contact(x) - Σ m_i g·x_i + Φ_damp(x)`,
+//! `x̂ = x_n + h v_n`,
+//!
+//! by Newton's method with a backtracking line search. `E` is the elastic energy with
+//! per-element PSD-clamped Hessians; Rayleigh damping `D = α M + β K_n` (`K_n` the clamped
+//! elastic Hessian at the start of the step) enters as `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
+//! Handle vertices follow their scripted positions and are removed from the unknowns. The
+//! Newton systems are solved by faer's sparse Cholesky on a symbolic analysis computed once
+//! (the pattern is that of the mesh stencils). Friction against obstacles is applied to the
+//! new velocities ([`crate::contact`]).
+
+use std::time::Instant;
+
+use nalgebra::{Matrix3, Vector3};
+use yarnhom_rve::linear::SpdSolver;
+
+use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
+use crate::elastic::{Assembly, ElasticModel};
+
+/// A piecewise linear translation over time (keyframes `(time_s, translation_m)`), constant
+/// before the first and after the last key.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Motion {
+    /// Keyframes, ascending in time.
+    pub keys: Vec<(f64, [f64; 3])>,
+}
+
+impl Motion {
+    /// The translation at `time_s`.
+    pub fn translation(&self, time_s: f64) -> Vector3<f64> {
+        let Some(first) = self.keys.first() else { return Vector3::zeros() };
+        if time_s <= first.0 {
+            return Vector3::from(first.1);
+        }
+        for w in self.keys.windows(2) {
+            let ((t0, a), (t1, b)) = (w[0], w[1]);
+            if time_s <= t1 {
+                let s = if t1 > t0 { (time_s - t0) / (t1 - t0) } else { 1.0 };
+                return Vector3::from(a) * (1.0 - s) + Vector3::from(b) * s;
+            }
+        }
+        Vector3::from(self.keys[self.keys.len() - 1].1)
+    }
+}
+
+/// Vertices held at their initial positions plus a scripted translation.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Handle {
+    /// The held vertices.
+    pub vertices: Vec<usize>,
+    /// Their translation over time.
+    pub motion: Motion,
+}
+
+/// Time step, forces and solver settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dynamics {
+    /// Time step `h` (s).
+    pub dt_s: f64,
+    /// Gravity (m/s²).
+    pub gravity: [f64; 3],
+    /// Rayleigh mass damping `α` (1/s).
+    pub mass_damping: f64,
+    /// Rayleigh stiffness damping `β` (s).
+    pub stiffness_damping: f64,
+    /// Most Newton iterations per step.
+    pub max_newton_iterations: u32,
+    /// Newton stops when the largest position update is below this (m).
+    pub tolerance_m: f64,
+}
+
+/// What one step did.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepStats {
+    /// Newton iterations.
+    pub newton_iterations: u32,
+    /// Largest free-DOF force imbalance at the end (N).
+    pub residual_n: f64,
+    /// Line-search halvings over all iterations.
+    pub line_search_steps: u32,
+    /// Whether Newton met its tolerance.
+    pub converged: bool,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+}
+
+/// Why a step failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StepError {
+    /// The Newton matrix could not be factored.
+    #[error("the Newton matrix is not positive definite at t = {time_s} s")]
+    Factorization {
+        /// Simulated time.
+        time_s: f64,
+    },
+    /// The state became non-finite.
+    #[error("the simulation diverged (non-finite positions) at t = {time_s} s")]
+    Diverged {
+        /// Simulated time.
+        time_s: f64,
+    },
+}
+
+/// A running cloth simulation.
+pub struct Simulation {
+    /// Elastic model.
+    pub model: ElasticModel,
+    /// Positions (m).
+    pub positions: Vec<Vector3<f64>>,
+    /// Velocities (m/s).
+    pub velocities: Vec<Vector3<f64>>,
+    /// Simulated time (s).
+    pub time_s: f64,
+    masses: Vec<f64>,
+    handles: Vec<Handle>,
+    handle_origins: Vec<Vec<Vector3<f64>>>,
+    fixed: Vec<bool>,
+    obstacles: Vec<Obstacle>,
+    contact: ContactSettings,
+    self_collision: Option<SelfCollision>,
+    dynamics: Dynamics,
+    solver: SpdSolver,
+}
+
+/// The parts of `Φ` that do not change within a step.
+struct StepTerms {
+    predicted: Vec<Vector3<f64>>,
+    start: Vec<Vector3<f64>>,
+    /// `β K_n` as lower triplets (empty without stiffness damping).
+    stiffness_damping: Vec<(usize, usize, f64)>,
+}
+
+impl Simulation {
+    /// A simulation starting at rest at `positions`.
+    pub fn new(
+        model: ElasticModel,
+        positions: Vec<Vector3<f64>>,
+        handles: Vec<Handle>,
+        obstacles: Vec<Obstacle>,
+        contact: ContactSettings,
+        dynamics: Dynamics,
+    ) -> Self {
+        let masses: Vec<f64> =
+            model.mesh.vertex_areas().iter().map(|a| a * model.material.areal_density_kg_m2).collect();
+        let mut fixed = vec![false; 3 * positions.len()];
+        for &v in handles.iter().flat_map(|h| &h.vertices) {
+            fixed[3 * v..3 * v + 3].fill(true);
+        }
+        let handle_origins = handles.iter().map(|h| h.vertices.iter().map(|&v| positions[v]).collect()).collect();
+        let self_collision = SelfCollision::new(&contact, &model.mesh.material);
+        Self {
+            velocities: vec![Vector3::zeros(); positions.len()],
+            positions,
+            time_s: 0.0,
+            masses,
+            handles,
+            handle_origins,
+            fixed,
+            obstacles,
+            contact,
+            self_collision,
+            dynamics,
+            solver: SpdSolver::default(),
+            model,
+        }
+    }
+
+    /// Kinetic energy (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        self.velocities.iter().zip(&self.masses).map(|(v, m)| 0.5 * m * v.norm_squared()).sum()
+    }
+
+    /// Gravitational potential energy relative to the origin (J).
+    pub fn gravity_energy(&self) -> f64 {
+        let g = Vector3::from(self.dynamics.gravity);
+        -self.positions.iter().zip(&self.masses).map(|(x, m)| m * g.dot(x)).sum::<f64>()
+    }
+
+    /// The obstacle contacts now.
+    pub fn obstacle_penetration_m(&self) -> f64 {
+        let deepest = self
+            .positions
+            .iter()
+            .flat_map(|p| self.obstacles.iter().map(move |o| o.distance(p).0))
+            .fold(f64::INFINITY, f64::min);
+        (-deepest).max(0.0)
+    }
+
+    /// Advance by one time step.
+    pub fn step(&mut self) -> Result<StepStats, StepError> {
+        let started = Instant::now();
+        let h = self.dynamics.dt_s;
+        let next_time = self.time_s + h;
+        let start = self.positions.clone();
+        let predicted: Vec<_> = start.iter().zip(&self.velocities).map(|(x, v)| x + h * v).collect();
+        let mut x = start.clone();
+        self.move_handles(&mut x, next_time);
+        let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new() };
+        let mut stats = StepStats { newton_iterations: 0, residual_n: 0.0, line_search_steps: 0, converged: false, wall_time_s: 0.0 };
+        for iteration in 0..self.dynamics.max_newton_iterations {
+            let mut a = self.assemble(&x, &terms);
+            if iteration == 0 && self.dynamics.stiffness_damping > 0.0 {
+                // K_n: the clamped elastic Hessian at the start of the step.
+                terms.stiffness_damping = self.elastic_hessian(&x);
+                self.add_damping(&x, &terms, &mut a);
+            }
+            self.remove_fixed(&mut a);
+            stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
+            self.solver
+                .factor(3 * x.len(), &a.triplets, 0.0)
+                .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
+            let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
+            self.solver.solve_in_place(&mut dx, 1);
+            let (alpha, halvings) = self.line_search(&x, &dx, &a, &terms);
+            stats.line_search_steps += halvings;
+            stats.newton_iterations = iteration + 1;
+            let mut largest: f64 = 0.0;
+            for (p, d) in x.iter_mut().zip(dx.chunks_exact(3)) {
+                let step = alpha * Vector3::new(d[0], d[1], d[2]);
+                largest = largest.max(step.amax());
+                *p += step;
+            }
+            if x.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
+                return Err(StepError::Diverged { time_s: self.time_s });
+            }
+            if largest < self.dynamics.tolerance_m {
+                stats.converged = true;
+                break;
+            }
+        }
+        self.finish_step(x, &terms.start, next_time);
+        stats.wall_time_s = started.elapsed().as_secs_f64();
+        Ok(stats)
+    }
+
+    /// Handle vertices at their scripted positions at `time_s`.
+    fn move_handles(&self, x: &mut [Vector3<f64>], time_s: f64) {
+        for (handle, origins) in self.handles.iter().zip(&self.handle_origins) {
+            let shift = handle.motion.translation(time_s) - handle.motion.translation(0.0);
+            for (&v, origin) in handle.vertices.iter().zip(origins) {
+                x[v] = origin + shift;
+            }
+        }
+    }
+
+    /// New velocities with obstacle friction, then the new state.
+    fn finish_step(&mut self, x: Vec<Vector3<f64>>, start: &[Vector3<f64>], time_s: f64) {
+        let h = self.dynamics.dt_s;
+        let mut v: Vec<Vector3<f64>> = x.iter().zip(start).map(|(a, b)| (a - b) / h).collect();
+        for c in obstacle_contacts(&self.obstacles, &self.contact, &x) {
+            // Coulomb: the friction impulse μ f_n h at most stops the tangential velocity.
+            let vn = c.normal * c.normal.dot(&v[c.vertex]);
+            let vt = v[c.vertex] - vn;
+            let speed = vt.norm();
+            if speed > 0.0 {
+                let slowdown = self.contact.friction * c.force_n * h / (self.masses[c.vertex] * speed);
+                v[c.vertex] = vn + vt * (1.0 - slowdown).max(0.0);
+            }
+        }
+        for (i, f) in self.fixed.chunks_exact(3).enumerate() {
+            if f[0] {
+                v[i] = (x[i] - start[i]) / h;
+            }
+        }
+        self.positions = x;
+        self.velocities = v;
+        self.time_s = time_s;
+    }
+
+    /// `Φ(x)` without the damping term's constant parts.
+    fn potential(&self, x: &[Vector3<f64>], terms: &StepTerms) -> f64 {
+        let h = self.dynamics.dt_s;
+        let g = Vector3::from(self.dynamics.gravity);
+        let (alpha, mut phi) = (self.dynamics.mass_damping, self.model.energy(x));
+        for (i, p) in x.iter().enumerate() {
+            let m = self.masses[i];
+            phi += m * (p - terms.predicted[i]).norm_squared() / (2.0 * h * h) - m * g.dot(p);
+            phi += alpha * m * (p - terms.start[i]).norm_squared() / (2.0 * h);
+        }
+        phi += crate::contact::obstacle_energy(&self.obstacles, &self.contact, x);
+        if let Some(s) = &self.self_collision {
+            phi += s.energy(&s.pairs(x));
+        }
+        if !terms.stiffness_damping.is_empty() {
+            let d = flatten_difference(x, &terms.start);
+            phi += 0.5 * dot(&d, &symmetric_product(&terms.stiffness_damping, &d)) / h;
+        }
+        phi
+    }
+
+    /// Gradient and Newton matrix of `Φ` (without stiffness damping, added on iteration 0).
+    fn assemble(&self, x: &[Vector3<f64>], terms: &StepTerms) -> Assembly {
+        let h = self.dynamics.dt_s;
+        let mut a = Assembly::new(3 * x.len());
+        self.model.assemble(x, true, &mut a);
+        let g = Vector3::from(self.dynamics.gravity);
+        let alpha = self.dynamics.mass_damping;
+        for (i, p) in x.iter().enumerate() {
+            let m = self.masses[i];
+            let force = m * (p - terms.predicted[i]) / (h * h) - m * g + alpha * m * (p - terms.start[i]) / h;
+            let diagonal = m / (h * h) + alpha * m / h;
+            for k in 0..3 {
+                a.gradient[3 * i + k] += force[k];
+                a.triplets.push((3 * i + k, 3 * i + k, diagonal));
+            }
+        }
+        let mut blocks: Vec<(usize, Matrix3<f64>)> = Vec::new();
+        for c in obstacle_contacts(&self.obstacles, &self.contact, x) {
+            for k in 0..3 {
+                a.gradient[3 * c.vertex + k] -= c.force_n * c.normal[k];
+            }
+            blocks.push((c.vertex, self.contact.stiffness_n_m * c.normal * c.normal.transpose()));
+        }
+        if let Some(s) = &self.self_collision {
+            s.forces(&s.pairs(x), &mut a.gradient, &mut blocks);
+        }
+        for (v, block) in blocks {
+            for k in 0..3 {
+                for l in 0..=k {
+                    a.triplets.push((3 * v + k, 3 * v + l, block[(k, l)]));
+                }
+            }
+        }
+        if !terms.stiffness_damping.is_empty() {
+            self.add_damping(x, terms, &mut a);
+        }
+        a
+    }
+
+    /// The clamped elastic Hessian at `x`, scaled by `β`.
+    fn elastic_hessian(&self, x: &[Vector3<f64>]) -> Vec<(usize, usize, f64)> {
+        let mut a = Assembly::new(3 * x.len());
+        self.model.assemble(x, true, &mut a);
+        let beta = self.dynamics.stiffness_damping;
+        a.triplets.into_iter().map(|(i, j, v)| (i, j, beta * v)).collect()
+    }
+
+    /// `β K_n (x - x_n) / h` into the gradient and `β K_n / h` into the matrix.
+    fn add_damping(&self, x: &[Vector3<f64>], terms: &StepTerms, a: &mut Assembly) {
+        let h = self.dynamics.dt_s;
+        let d = flatten_difference(x, &terms.start);
+        for (g, kd) in a.gradient.iter_mut().zip(symmetric_product(&terms.stiffness_damping, &d)) {
+            *g += kd / h;
+        }
+        a.triplets.extend(terms.stiffness_damping.iter().map(|&(i, j, v)| (i, j, v / h)));
+    }
+
+    /// Fixed DOFs: zero gradient, identity rows and columns.
+    fn remove_fixed(&self, a: &mut Assembly) {
+        let fixed = &self.fixed;
+        a.triplets.retain(|&(i, j, _)| !fixed[i] && !fixed[j]);
+        for (dof, &f) in fixed.iter().enumerate() {
+            if f {
+                a.gradient[dof] = 0.0;
+                a.triplets.push((dof, dof, 1.0));
+            }
+        }
+    }
+
+    /// Backtracking (Armijo) on `Φ` along `dx`: the step length and the number of halvings.
+    fn line_search(&self, x: &[Vector3<f64>], dx: &[f64], a: &Assembly, terms: &StepTerms) -> (f64, u32) {
+        let phi0 = self.potential(x, terms);
+        let slope = dot(&a.gradient, dx);
+        let mut alpha = 1.0;
+        for halvings in 0..30 {
+            let trial: Vec<_> =
+                x.iter().zip(dx.chunks_exact(3)).map(|(p, d)| p + alpha * Vector3::new(d[0], d[1], d[2])).collect();
+            let phi = self.potential(&trial, terms);
+            if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
+                return (alpha, halvings);
+            }
+            alpha *= 0.5;
+        }
+        (alpha, 30)
+    }
+}
+
+fn flatten_difference(x: &[Vector3<f64>], y: &[Vector3<f64>]) -> Vec<f64> {
+    x.iter().zip(y).flat_map(|(a, b)| (a - b).iter().copied().collect::<Vec<_>>()).collect()
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// `A v` for a symmetric `A` given by its lower-triangle triplets.
+fn symmetric_product(lower: &[(usize, usize, f64)], v: &[f64]) -> Vec<f64> {
+    let mut out = vec![0.0; v.len()];
+    for &(i, j, a) in lower {
+        out[i] += a * v[j];
+        if i != j {
+            out[j] += a * v[i];
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn motions_interpolate_their_keys() {
+        let m = Motion { keys: vec![(0.0, [0.0; 3]), (0.4, [0.035, 0.0, 0.0])] };
+        assert_eq!(m.translation(-1.0), Vector3::zeros());
+        assert!((m.translation(0.2).x - 0.0175).abs() < 1e-15);
+        assert!((m.translation(1.0).x - 0.035).abs() < 1e-15);
+        assert_eq!(Motion::default().translation(3.0), Vector3::zeros());
+    }
+}
