@@ -6,6 +6,8 @@
 
 mod convert;
 mod diff;
+mod fit;
+mod fit_plot;
 mod grid;
 mod inputs;
 mod inspect;
@@ -14,6 +16,7 @@ mod pattern;
 mod rve;
 mod sample;
 mod schema;
+mod shell;
 
 use std::process::ExitCode;
 
@@ -45,6 +48,13 @@ enum Command {
     /// Sampled energy grids (thesis App. A.3.1): merge the shards of a sampling run.
     #[command(subcommand)]
     Grid(grid::GridCommand),
+    /// Homogenized cloth materials (thesis Sec. 4.1, App. A.3): fit a sampled grid into a
+    /// spline material; import and export ARCSim-HYLC material JSON; plot and compare fits.
+    Fit(fit::FitArgs),
+    /// Thin-shell cloth simulation (thesis Sec. 4.2, Ch. 6) of scenes with spline or Ch. 6
+    /// materials, recorded as MCAP traces.
+    #[command(subcommand)]
+    Shell(shell::ShellCommand),
     /// Describe an artifact: kind, schema version, provenance and a human summary.
     Inspect(inspect::InspectArgs),
     /// Convert an artifact between `.yh`, JSON, HDF5 and `.pyp`.
@@ -67,6 +77,8 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Model(cmd) => model::run(cmd),
         Command::Rve(cmd) => rve::run(cmd),
         Command::Grid(cmd) => grid::run(cmd),
+        Command::Fit(args) => fit::run(args),
+        Command::Shell(cmd) => shell::run(cmd),
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Schema(args) => schema::run(args),

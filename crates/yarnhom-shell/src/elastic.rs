@@ -59,21 +59,30 @@ impl Assembly {
     }
 }
 
-/// Clamp the eigenvalues of a symmetric element Hessian to be non-negative. Matrices that are
-/// already positive semidefinite (a Cholesky factorization of `H + ε I` succeeds, `ε` at
-/// rounding level) are returned untouched, skipping the eigensolver.
-pub fn project_psd<const N: usize>(h: SMatrix<f64, N, N>) -> SMatrix<f64, N, N> {
+/// Whether a symmetric matrix is positive semidefinite up to rounding: a Cholesky
+/// factorization of `H + ε I` (`ε` at rounding level) succeeds.
+fn is_psd<const N: usize>(h: &SMatrix<f64, N, N>) -> bool {
     let scale = h.diagonal().amax().max(f64::MIN_POSITIVE);
-    let shifted = h + SMatrix::<f64, N, N>::identity() * (1e-12 * scale);
-    if nalgebra::Cholesky::new(shifted).is_some() {
-        return h;
-    }
-    // The eigensolver is generic over dimensions fixed by type-level numbers, not const
-    // generics, so the (rarer) indefinite case goes through a dynamic matrix.
-    let mut eigen = nalgebra::SymmetricEigen::new(nalgebra::DMatrix::from_column_slice(N, N, h.as_slice()));
-    eigen.eigenvalues.iter_mut().for_each(|l| *l = l.max(0.0));
-    SMatrix::<f64, N, N>::from_column_slice(eigen.recompose().as_slice())
+    nalgebra::Cholesky::new(h + SMatrix::<f64, N, N>::identity() * (1e-12 * scale)).is_some()
 }
+
+macro_rules! psd_projection {
+    ($name:ident, $n:literal) => {
+        /// Clamp the eigenvalues of a symmetric element Hessian to be non-negative; matrices that
+        /// are already positive semidefinite are returned untouched, skipping the eigensolver.
+        pub fn $name(h: SMatrix<f64, $n, $n>) -> SMatrix<f64, $n, $n> {
+            if is_psd(&h) {
+                return h;
+            }
+            let mut eigen = nalgebra::SymmetricEigen::new(h);
+            eigen.eigenvalues.iter_mut().for_each(|l| *l = l.max(0.0));
+            eigen.recompose()
+        }
+    };
+}
+
+psd_projection!(project_psd_12, 12);
+psd_projection!(project_psd_18, 18);
 
 /// A cloth's elastic energy: mesh, rest data and material.
 #[derive(Debug, Clone)]
@@ -161,7 +170,7 @@ impl ElasticModel {
             .zip(&self.mesh.hinges)
             .map(|(rest, h)| {
                 let d = hinge_energy_with_derivatives(rest, &h.vertices.map(|v| x[v as usize]));
-                (d.energy, d.gradient, hessian.then(|| project_psd(d.hessian)))
+                (d.energy, d.gradient, hessian.then(|| project_psd_12(d.hessian)))
             })
             .collect();
         for ((e, g, h), hinge) in hinges.iter().zip(&self.mesh.hinges) {
@@ -184,7 +193,7 @@ impl ElasticModel {
                     h += jet.gradient[k] * d2z;
                 }
             }
-            project_psd(area * h)
+            project_psd_18(area * h)
         });
         (area * jet.value, gradient, h)
     }
@@ -241,11 +250,14 @@ mod tests {
 
     #[test]
     fn projected_hessians_are_psd_and_psd_ones_are_untouched() {
-        let a = SMatrix::<f64, 3, 3>::new(2.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.5);
-        let p = project_psd(a);
-        assert!(p.symmetric_eigenvalues().iter().all(|&l| l >= -1e-15));
-        assert!((p[(1, 1)]).abs() < 1e-15 && (p[(0, 0)] - 2.0).abs() < 1e-15);
-        let spd = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 3.0);
-        assert_eq!(project_psd(spd), spd);
+        let mut a = SMatrix::<f64, 12, 12>::identity();
+        a[(1, 1)] = -1.0;
+        a[(0, 1)] = 0.5;
+        a[(1, 0)] = 0.5;
+        let p = project_psd_12(a);
+        assert!(p.symmetric_eigenvalues().iter().all(|&l| l >= -1e-14));
+        assert!((p[(5, 5)] - 1.0).abs() < 1e-14 && p[(1, 1)] > -1.0);
+        let spd = SMatrix::<f64, 18, 18>::identity() * 2.0;
+        assert_eq!(project_psd_18(spd), spd);
     }
 }

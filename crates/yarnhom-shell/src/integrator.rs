@@ -179,7 +179,15 @@ impl Simulation {
         -self.positions.iter().zip(&self.masses).map(|(x, m)| m * g.dot(x)).sum::<f64>()
     }
 
-    /// The obstacle contacts now.
+    /// The elastic force the cloth exerts on handle `k` (N): the elastic energy gradient summed
+    /// over its vertices (the force the handle must apply to hold them is its negative).
+    pub fn handle_force_n(&self, k: usize) -> Vector3<f64> {
+        let mut a = Assembly::new(3 * self.positions.len());
+        self.model.assemble(&self.positions, false, &mut a);
+        self.handles[k].vertices.iter().map(|&v| -Vector3::new(a.gradient[3 * v], a.gradient[3 * v + 1], a.gradient[3 * v + 2])).sum()
+    }
+
+    /// Deepest penetration of any vertex into an obstacle (m), 0 if none.
     pub fn obstacle_penetration_m(&self) -> f64 {
         let deepest = self
             .positions

@@ -7,6 +7,7 @@
 //! - [`elastic`]: per-element energies, the derivative split (A.43)-(A.44), PSD clamping.
 //! - [`contact`]: obstacles, friction and self-collision.
 //! - [`scene`], [`arcsim_scene`]: scene files, built-ins and the published ARCSim scenes.
+//! - [`simulate`]: running a scene frame by frame.
 //! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping.
 
 pub mod arcsim_scene;
@@ -19,6 +20,7 @@ pub mod integrator;
 pub mod material;
 pub mod mesh;
 pub mod scene;
+pub mod simulate;
 #[cfg(test)]
 mod test_support;
 

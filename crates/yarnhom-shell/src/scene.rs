@@ -69,7 +69,8 @@ pub enum HandleSpec {
         /// Index into the motions, if it moves.
         motion: Option<usize>,
     },
-    /// The vertices within a sphere (ARCSim's handlesphere).
+    /// The vertices within a sphere (ARCSim's handlesphere), or the nearest vertex if the mesh
+    /// has none inside.
     Sphere {
         /// Centre (m).
         center: [f64; 3],
@@ -218,7 +219,12 @@ impl Scene {
             .iter()
             .enumerate()
             .map(|(k, spec)| {
-                let vertices: Vec<usize> = (0..positions.len()).filter(|&v| self.holds(spec, &positions[v])).collect();
+                let mut vertices: Vec<usize> = (0..positions.len()).filter(|&v| self.holds(spec, &positions[v])).collect();
+                if let (true, HandleSpec::Sphere { center, .. }) = (vertices.is_empty(), spec) {
+                    // A coarse mesh may have no vertex inside a small sphere: hold the nearest.
+                    let distance = |v: usize| (positions[v] - Vector3::from(*center)).norm();
+                    vertices.extend((0..positions.len()).min_by(|&a, &b| distance(a).total_cmp(&distance(b))));
+                }
                 if vertices.is_empty() {
                     return Err(SceneError::Invalid { scene: self.name.clone(), problem: format!("handle {k} holds no vertex") });
                 }

@@ -1,0 +1,244 @@
+//! `yarnhom fit ...`: homogenized cloth materials from sampled grids (thesis Sec. 4.1, App.
+//! A.3), and the ARCSim-HYLC material JSON in both directions.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use yarnhom_artifacts::arcsim::{ArcsimMaterial, read_spline};
+use yarnhom_artifacts::{AnyArtifact, FitSettings, Grid, InputRef, Spline, container};
+use yarnhom_fit::{SplineMaterial, fit_errors, fit_grid};
+
+use crate::Outcome;
+use crate::inputs::{self, provenance};
+
+/// `yarnhom fit GRID -o X.spline.yh`, or one of the subcommands.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct FitArgs {
+    #[command(subcommand)]
+    pub command: Option<FitCommand>,
+    #[command(flatten)]
+    pub grid: GridFitArgs,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum FitCommand {
+    /// Read a published ARCSim-HYLC material JSON (e.g. `../shared/data/hylc-materials/stock1.json`)
+    /// into a `spline` artifact.
+    ImportArcsim(ImportArgs),
+    /// Write a `spline` artifact as ARCSim-HYLC material JSON, for ARCSim-HYLC to simulate.
+    ExportArcsim(ExportArgs),
+    /// Figures of a fit against its grid: per 1D term data, fit and control points (Fig. 4.4);
+    /// per 2D term data, sum of 1D fits, residual, fit and error heat maps (Fig. 4.5). SVG.
+    Plot(PlotArgs),
+    /// Compare two spline materials term by term on the sampled strain ranges (e.g. our fit of
+    /// a pattern against the published fit of it): RMS and largest differences per 1D term.
+    Compare(CompareArgs),
+}
+
+/// Fitting a grid.
+#[derive(Debug, Args)]
+pub struct GridFitArgs {
+    /// The sampled grid (`yarnhom rve sample`).
+    #[arg(required = true)]
+    pub grid: Option<PathBuf>,
+    /// Output spline file.
+    #[arg(short, long, required = true)]
+    pub output: Option<PathBuf>,
+    /// Areal mass density of the cloth (kg/m²); default 0.3.
+    #[arg(long, default_value_t = 0.3)]
+    pub areal_density: f64,
+    /// The stockinette settings of Sec. 4.3 and App. A.3: 2D bending knots within 30% of the
+    /// range, quasiconvexity slope 0.01.
+    #[arg(long)]
+    pub stockinette: bool,
+    /// Quasiconvexity slope `p_min` of the marching (A.36); default 0.001.
+    #[arg(long)]
+    pub min_slope: Option<f64>,
+    /// Control points on each side of 0 for 1D terms (default 5).
+    #[arg(long)]
+    pub knots_1d: Option<u32>,
+    /// Control points on each side of 0 for each axis of 2D terms (default 4).
+    #[arg(long)]
+    pub knots_2d: Option<u32>,
+    /// Smallest MLS support radius in normalized strain (A.35; default 0.12).
+    #[arg(long)]
+    pub mls_radius: Option<f64>,
+    /// Do not symmetrize the data in `sa`.
+    #[arg(long)]
+    pub no_shear_symmetry: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// ARCSim-HYLC material JSON.
+    pub input: PathBuf,
+    /// Output spline file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// A spline artifact.
+    pub input: PathBuf,
+    /// Output JSON file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct PlotArgs {
+    /// The grid the spline was fitted to.
+    pub grid: PathBuf,
+    /// The spline (`.spline.yh`, or an ARCSim-HYLC JSON).
+    pub spline: PathBuf,
+    /// Output folder for the figures.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// First spline (`.spline.yh` or ARCSim-HYLC JSON).
+    pub first: PathBuf,
+    /// Second spline.
+    pub second: PathBuf,
+}
+
+pub fn run(args: FitArgs) -> anyhow::Result<Outcome> {
+    match args.command {
+        Some(FitCommand::ImportArcsim(a)) => import(a),
+        Some(FitCommand::ExportArcsim(a)) => export(a),
+        Some(FitCommand::Plot(a)) => plot(a),
+        Some(FitCommand::Compare(a)) => compare(a),
+        None => fit(args.grid),
+    }
+}
+
+fn settings(args: &GridFitArgs) -> FitSettings {
+    let mut s = FitSettings::default();
+    if args.stockinette {
+        s.span_2d_bending = 0.3;
+        s.min_slope = 0.01;
+    }
+    s.min_slope = args.min_slope.unwrap_or(s.min_slope);
+    s.knots_per_side_1d = args.knots_1d.unwrap_or(s.knots_per_side_1d);
+    s.knots_per_side_2d = args.knots_2d.unwrap_or(s.knots_per_side_2d);
+    s.mls_radius = args.mls_radius.unwrap_or(s.mls_radius);
+    s.symmetrize_shear = !args.no_shear_symmetry;
+    s
+}
+
+/// A grid artifact from a file, with its input reference.
+fn load_grid(path: &Path) -> anyhow::Result<(Grid, InputRef)> {
+    let loaded = inputs::load(path, None)?;
+    let input = InputRef { kind: "grid".into(), content_hash: loaded.header.content_hash.clone(), path: path.display().to_string() };
+    match loaded.artifact {
+        AnyArtifact::Grid(grid) => Ok((grid, input)),
+        other => anyhow::bail!("{}: holds a '{}', not a grid", path.display(), other.kind()),
+    }
+}
+
+/// A spline from a `.spline.yh` (or its JSON/HDF5 forms) or an ARCSim-HYLC JSON.
+pub fn load_spline(path: &Path) -> anyhow::Result<Spline> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    if inputs::Format::sniff(&bytes).is_none() || bytes.windows(13).any(|w| w == b"\"strain scale") {
+        return Ok(read_spline(path)?);
+    }
+    match inputs::load(path, None)?.artifact {
+        AnyArtifact::Spline(spline) => Ok(spline),
+        other => anyhow::bail!("{}: holds a '{}', not a spline", path.display(), other.kind()),
+    }
+}
+
+fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
+    let (Some(grid_path), Some(output)) = (&args.grid, &args.output) else {
+        anyhow::bail!("usage: yarnhom fit GRID -o OUTPUT.spline.yh");
+    };
+    let (grid, input) = load_grid(grid_path)?;
+    if !grid.is_complete() {
+        eprintln!("warning: the grid holds {} of its plan's {} samples", grid.samples.len(), grid.expected_samples());
+    }
+    let spline = fit_grid(&grid, &settings(&args), args.areal_density)
+        .with_context(|| format!("cannot fit {}", grid_path.display()))?;
+    container::write(output, &spline, &provenance("fit", vec![input]))?;
+    println!("{}", spline.summary());
+    print_errors(&grid, &spline);
+    println!("wrote {}", output.display());
+    Ok(Outcome::Success)
+}
+
+/// The fit's relative RMS error on each term of its grid (the acceptance figure).
+fn print_errors(grid: &Grid, spline: &Spline) {
+    let material = SplineMaterial::from(spline);
+    println!("relative RMS error of the fit on its grid (of Ψ; of Ψ - f0):");
+    for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2) {
+        println!("  {:8} {:5} samples  {:6.2}%  {:6.2}%", e.term, e.samples, 100.0 * e.relative_rms, 100.0 * e.relative_rms_deformation);
+    }
+}
+
+fn import(args: ImportArgs) -> anyhow::Result<Outcome> {
+    let spline = read_spline(&args.input)?;
+    container::write(&args.output, &spline, &provenance("fit import-arcsim", Vec::new()))?;
+    println!("{}", spline.summary());
+    println!("wrote {}", args.output.display());
+    Ok(Outcome::Success)
+}
+
+fn export(args: ExportArgs) -> anyhow::Result<Outcome> {
+    let spline = load_spline(&args.input)?;
+    let json = ArcsimMaterial::from_spline(&spline).to_json()?;
+    std::fs::write(&args.output, json).with_context(|| format!("cannot write {}", args.output.display()))?;
+    println!("wrote {}", args.output.display());
+    Ok(Outcome::Success)
+}
+
+fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
+    let (grid, _) = load_grid(&args.grid)?;
+    let spline = load_spline(&args.spline)?;
+    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot create {}", args.output.display()))?;
+    for path in crate::fit_plot::plot_fit(&grid, &spline, &args.output)? {
+        println!("wrote {}", path.display());
+    }
+    Ok(Outcome::Success)
+}
+
+/// Strains along each 1D term for comparisons: the first spline's normalization range.
+fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
+    let (a, b) = (load_spline(&args.first)?, load_spline(&args.second)?);
+    let (ma, mb) = (SplineMaterial::from(&a), SplineMaterial::from(&b));
+    println!("1D terms (energy relative to rest, J/m²) over ±strain scale of '{}':", a.name);
+    println!("  term   RMS first  RMS second  RMS difference  shape correlation");
+    for axis in 0..5 {
+        let scale = a.strain_scale[axis];
+        let xs: Vec<f64> = (0..=100).map(|k| scale * (-1.0 + 0.02 * f64::from(k))).collect();
+        let curve = |m: &SplineMaterial| -> Option<Vec<f64>> {
+            let zero = m.term_1d(axis, 0.0)?;
+            xs.iter().map(|&x| m.term_1d(axis, x).map(|v| v - zero)).collect()
+        };
+        let (Some(ca), Some(cb)) = (curve(&ma), curve(&mb)) else { continue };
+        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
+        let diff: Vec<f64> = ca.iter().zip(&cb).map(|(x, y)| x - y).collect();
+        println!(
+            "  {:4} {:11.4e} {:11.4e} {:15.4e} {:18.3}",
+            yarnhom_artifacts::grid::AXIS_NAMES[axis],
+            rms(&ca),
+            rms(&cb),
+            rms(&diff),
+            correlation(&ca, &cb)
+        );
+    }
+    Ok(Outcome::Success)
+}
+
+/// Pearson correlation of two curves: 1 for the same shape up to scale.
+fn correlation(a: &[f64], b: &[f64]) -> f64 {
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let (ma, mb) = (mean(a), mean(b));
+    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
+    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
+    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}

@@ -1,0 +1,214 @@
+//! `yarnhom shell ...`: thin-shell cloth simulation with homogenized or Ch. 6 materials.
+
+use std::collections::BTreeMap;
+use std::io::{Seek, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Deserialize;
+use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::simulate::{FrameReport, run as run_scene};
+use yarnhom_shell::{HingeBending, Scene, ShellMaterial, Simulation, StvkNeoHookean};
+use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceMetadata, TraceWriter};
+
+use crate::Outcome;
+
+#[derive(Debug, Subcommand)]
+pub enum ShellCommand {
+    /// Simulate a scene and write an MCAP trace: the mesh topology once, the vertex positions
+    /// of every frame (`/mesh/frame`), energies per frame (`/metrics`) and Newton statistics per
+    /// time step (`/solver`); optionally OBJ files per frame.
+    Simulate(SimulateArgs),
+    /// Write a built-in scene (stretch-x, stretch-y, drape) as a JSON scene file to edit.
+    Scene(SceneArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct SimulateArgs {
+    /// A built-in scene (stretch-x, stretch-y, drape), a yarnhom scene JSON or an ARCSim-HYLC
+    /// scene JSON (`../shared/data/hylc-scenes/*.json`).
+    pub scene: String,
+    /// The material: a `.spline.yh` (`yarnhom fit`), an ARCSim-HYLC material JSON, or a JSON
+    /// file `{"areal_density_kg_m2", "membrane": {k_xx, k_xy, k_yy, k_ss, k_n1, k_n2},
+    /// "bending": {k_weft, k_bias, k_warp}}` for the Ch. 6 model (6.1), (6.4).
+    #[arg(long)]
+    pub material: PathBuf,
+    /// Output trace (`.mcap`); `-` writes to stdout.
+    #[arg(short, long)]
+    pub output: String,
+    /// Also write every frame as `frame_NNNN.obj` into this folder.
+    #[arg(long)]
+    pub obj_dir: Option<PathBuf>,
+    /// Stop after this many frames (default: the scene's end time).
+    #[arg(long)]
+    pub frames: Option<u64>,
+    /// Vertices per side of the cloth (overrides the scene).
+    #[arg(long)]
+    pub resolution: Option<usize>,
+    /// Implicit time steps per frame (overrides the scene).
+    #[arg(long)]
+    pub steps_per_frame: Option<u32>,
+}
+
+#[derive(Debug, Args)]
+pub struct SceneArgs {
+    /// Built-in name.
+    pub name: String,
+    /// Output JSON file.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+pub fn run(cmd: ShellCommand) -> anyhow::Result<Outcome> {
+    match cmd {
+        ShellCommand::Simulate(args) => simulate(args),
+        ShellCommand::Scene(args) => {
+            let scene = Scene::builtin(&args.name)?;
+            std::fs::write(&args.output, serde_json::to_string_pretty(&scene)?)
+                .with_context(|| format!("cannot write {}", args.output.display()))?;
+            println!("wrote {}", args.output.display());
+            Ok(Outcome::Success)
+        }
+    }
+}
+
+/// The Ch. 6 model as a JSON file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StvkFile {
+    areal_density_kg_m2: f64,
+    membrane: StvkNeoHookean,
+    bending: HingeBending,
+}
+
+/// A material from a spline artifact, an ARCSim-HYLC JSON or a Ch. 6 JSON file.
+pub fn load_material(path: &Path) -> anyhow::Result<ShellMaterial> {
+    let text = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    if text.windows(10).any(|w| w == b"\"membrane\"") {
+        let file: StvkFile = serde_json::from_slice(&text).with_context(|| format!("{}: not a Ch. 6 material", path.display()))?;
+        return Ok(ShellMaterial::stvk(file.areal_density_kg_m2, file.membrane, file.bending));
+    }
+    let spline = crate::fit::load_spline(path)?;
+    Ok(ShellMaterial::spline(SplineMaterial::from(&spline)))
+}
+
+fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
+    let mut scene = Scene::load(&args.scene)?;
+    if let Some(n) = args.resolution {
+        scene.vertices = [n, n];
+    }
+    scene.steps_per_frame = args.steps_per_frame.unwrap_or(scene.steps_per_frame);
+    let material = load_material(&args.material)?;
+    let metadata = TraceMetadata::new("yarnhom shell simulate", env!("CARGO_PKG_VERSION"))
+        .with_entry("scene", &args.scene)
+        .with_entry("material", args.material.display().to_string());
+    if args.output == "-" {
+        record(TraceWriter::to_stdout()?, &scene, material, &args, &metadata)
+    } else {
+        let out = record(TraceWriter::create(&args.output)?, &scene, material, &args, &metadata)?;
+        eprintln!("wrote {}", args.output);
+        Ok(out)
+    }
+}
+
+/// Run the scene, writing each frame to the trace (and OBJ files).
+fn record<W: Write + Seek>(
+    mut trace: TraceWriter<W>,
+    scene: &Scene,
+    material: ShellMaterial,
+    args: &SimulateArgs,
+    metadata: &TraceMetadata,
+) -> anyhow::Result<Outcome> {
+    trace.write_metadata(metadata)?;
+    let total = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
+    let bar = ProgressBar::new(total);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} frame {pos}/{len}, {elapsed} elapsed, ETA {eta} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    if let Some(dir) = &args.obj_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let mut newton_total = 0u64;
+    let mut steps_total = 0u64;
+    let sim = run_scene(scene, material, args.frames, |report, sim| {
+        if report.frame == 0 {
+            trace.write_topology(&topology(sim, &scene.name)).map_err(|e| e.to_string())?;
+        }
+        write_frame(&mut trace, report, sim, &scene.name).map_err(|e| e.to_string())?;
+        if let Some(dir) = &args.obj_dir {
+            write_obj(&dir.join(format!("frame_{:04}.obj", report.frame)), sim).map_err(|e| e.to_string())?;
+        }
+        newton_total += report.steps.iter().map(|s| u64::from(s.newton_iterations)).sum::<u64>();
+        steps_total += report.steps.len() as u64;
+        bar.set_position(report.frame);
+        bar.set_message(format!("E {:.3e} J", report.elastic_energy_j));
+        Ok(())
+    })?;
+    bar.finish_and_clear();
+    trace.finish()?;
+    eprintln!(
+        "simulated {} s in {} steps ({} Newton iterations), {} vertices; elastic energy {:.4e} J",
+        sim.time_s,
+        steps_total,
+        newton_total,
+        sim.positions.len(),
+        sim.model.energy(&sim.positions)
+    );
+    Ok(Outcome::Success)
+}
+
+fn topology(sim: &Simulation, name: &str) -> MeshTopology {
+    MeshTopology {
+        triangles: sim.model.mesh.triangles.clone(),
+        rest_positions_m: sim.model.mesh.material.iter().map(|m| [m.x, m.y, 0.0]).collect(),
+        name: name.into(),
+    }
+}
+
+fn write_frame<W: Write + Seek>(
+    trace: &mut TraceWriter<W>,
+    report: &FrameReport,
+    sim: &Simulation,
+    name: &str,
+) -> Result<(), yarnhom_trace::TraceError> {
+    let positions_m = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+    trace.write_frame(&MeshFrame { mesh: name.into(), frame: report.frame, time_s: report.time_s, positions_m })?;
+    let values = BTreeMap::from([
+        ("elastic_energy_j".to_string(), report.elastic_energy_j),
+        ("kinetic_energy_j".to_string(), report.kinetic_energy_j),
+        ("gravity_energy_j".to_string(), report.gravity_energy_j),
+        ("penetration_m".to_string(), report.penetration_m),
+    ]);
+    trace.write_scalars(&Scalars { frame: report.frame, time_s: report.time_s, values })?;
+    for s in &report.steps {
+        trace.write_solver_step(&SolverStep {
+            frame: report.frame,
+            time_s: report.time_s,
+            newton_iterations: s.newton_iterations,
+            residual: s.residual_n,
+            line_search_steps: s.line_search_steps,
+            converged: s.converged,
+            wall_time_s: s.wall_time_s,
+        })?;
+    }
+    Ok(())
+}
+
+/// One frame as a Wavefront OBJ with material coordinates as texture coordinates.
+fn write_obj(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for p in &sim.positions {
+        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+    }
+    for m in &sim.model.mesh.material {
+        writeln!(out, "vt {} {}", m.x, m.y)?;
+    }
+    for t in &sim.model.mesh.triangles {
+        let [a, b, c] = t.map(|v| v + 1);
+        writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}")?;
+    }
+    out.flush()
+}
