@@ -1,0 +1,149 @@
+//! Physical behaviour of the shell simulator with the published HYLC materials (Sec. 4.3.1):
+//! stockinette curls, honeycomb narrows, rib is anisotropic, relaxation dissipates, a drape
+//! rests on a sphere without penetrating it. Coarse meshes and large steps keep them fast.
+
+use nalgebra::Vector3;
+use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::scene::HandleSpec;
+use yarnhom_shell::simulate::prepare;
+use yarnhom_shell::{Scene, ShellMaterial, Simulation};
+
+fn published(name: &str) -> ShellMaterial {
+    let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
+    ShellMaterial::spline(SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published material")))
+}
+
+/// A builtin at `n x n` vertices with `steps` steps per 1/60 s frame.
+fn scene(name: &str, n: usize, steps: u32) -> Scene {
+    let mut scene = Scene::builtin(name).expect("builtin");
+    scene.vertices = [n, n];
+    scene.steps_per_frame = steps;
+    scene.tolerance_m = 1e-6;
+    scene
+}
+
+fn run_steps(sim: &mut Simulation, steps: usize) {
+    for _ in 0..steps {
+        sim.step().expect("step");
+    }
+}
+
+/// Width along y of the cloth's middle third in x.
+fn middle_width(sim: &Simulation) -> f64 {
+    let middle: Vec<&Vector3<f64>> = sim
+        .model
+        .mesh
+        .material
+        .iter()
+        .zip(&sim.positions)
+        .filter(|(m, _)| m.x.abs() < 0.02)
+        .map(|(_, p)| p)
+        .collect();
+    let (lo, hi) = middle.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    hi - lo
+}
+
+#[test]
+fn honeycomb_narrows_when_stretched_and_more_than_satin() {
+    // Poisson effect (Fig. 4.8): stretched 2 x 3.5 cm along x, the honeycomb's middle narrows.
+    let narrowing = |material: &str| {
+        let mut s = scene("stretch-x", 13, 1);
+        s.gravity = [0.0; 3];
+        let mut sim = prepare(&s, published(material)).expect("scene");
+        run_steps(&mut sim, 40);
+        1.0 - middle_width(&sim) / 0.3
+    };
+    let (honey, satin) = (narrowing("honey1"), narrowing("satin1"));
+    eprintln!("narrowing: honey {:.2}%, satin {:.2}%", 100.0 * honey, 100.0 * satin);
+    assert!(honey > 0.05, "honeycomb narrows by {:.1}%", 100.0 * honey);
+    assert!(honey > 2.0 * satin, "honeycomb {:.1}% vs satin {:.1}%", 100.0 * honey, 100.0 * satin);
+}
+
+#[test]
+fn rib_resists_stretch_along_y_far_more_than_along_x() {
+    // Same handle displacement along x and along y: the force needed along y is much larger,
+    // i.e. under one force the rib extends far more along x.
+    let force = |name: &str, axis: usize| {
+        let mut s = scene(name, 13, 1);
+        s.gravity = [0.0; 3];
+        let mut sim = prepare(&s, published("rib1")).expect("scene");
+        run_steps(&mut sim, 40);
+        sim.handle_force_n(1)[axis].abs()
+    };
+    let (fx, fy) = (force("stretch-x", 0), force("stretch-y", 1));
+    eprintln!("rib handle force: x {fx:.4} N, y {fy:.4} N");
+    assert!(fy > 3.0 * fx, "rib: force along x {fx:.4} N, along y {fy:.4} N");
+}
+
+#[test]
+fn hanging_stockinette_curls_at_its_free_edges_and_satin_does_not() {
+    // Held along its top edge (+y), gravity along -y in the cloth's plane: the stockinette's
+    // rest curvature rolls its free edges out of the plane (Sec. 4.3, Fig. 4.6).
+    let curl = |material: &str| {
+        let mut s = scene("stretch-x", 13, 1);
+        s.gravity = [0.0, -9.81, 0.0];
+        s.handles = vec![HandleSpec::Bar { side: 3, length: 1.0, width: 0.02, inset: 0.0, motion: None }];
+        s.motions.clear();
+        let mut sim = prepare(&s, published(material)).expect("scene");
+        run_steps(&mut sim, 40);
+        let edge: Vec<f64> = sim
+            .model
+            .mesh
+            .material
+            .iter()
+            .zip(&sim.positions)
+            .filter(|(m, _)| m.x.abs() > 0.149 || m.y < -0.149)
+            .map(|(_, p)| p.z.abs())
+            .collect();
+        edge.iter().sum::<f64>() / edge.len() as f64
+    };
+    let (stock, satin) = (curl("stock1"), curl("satin1"));
+    eprintln!("free-edge curl: stock {:.2} mm, satin {:.2} mm", 1e3 * stock, 1e3 * satin);
+    assert!(stock > 0.01, "stockinette free edges leave the plane by {:.1} mm on average", 1e3 * stock);
+    assert!(stock > 5.0 * satin, "stockinette {:.2} mm vs satin {:.2} mm", 1e3 * stock, 1e3 * satin);
+}
+
+#[test]
+fn relaxation_without_driving_never_gains_energy() {
+    // Free cloth, no gravity, no moving handles, released from a bumped state: implicit Euler
+    // with damping dissipates, so elastic + kinetic energy never grows.
+    let mut s = scene("stretch-x", 11, 1);
+    s.gravity = [0.0; 3];
+    s.handles.clear();
+    let mut sim = prepare(&s, published("basket1")).expect("scene");
+    for (p, m) in sim.positions.iter_mut().zip(&sim.model.mesh.material) {
+        p.z = 0.02 * (10.0 * m.x).sin() * (10.0 * m.y).cos();
+        p.x *= 1.05;
+    }
+    let total = |sim: &Simulation| sim.model.energy(&sim.positions) + sim.kinetic_energy();
+    let mut last = total(&sim);
+    let first = last;
+    for step in 0..30 {
+        sim.step().expect("step");
+        let now = total(&sim);
+        assert!(now <= last * (1.0 + 1e-9) + 1e-12, "step {step}: energy rose from {last:.6e} to {now:.6e} J");
+        last = now;
+    }
+    eprintln!("relaxation: {first:.3e} -> {last:.3e} J");
+    assert!(last < 0.5 * first, "relaxation dissipates: {first:.3e} -> {last:.3e} J");
+}
+
+#[test]
+fn a_patch_draped_on_a_sphere_comes_to_rest_without_penetrating_it() {
+    let mut s = scene("drape", 13, 1);
+    s.handles.clear();
+    s.frame_time_s = 0.02;
+    s.obstacles = vec![yarnhom_shell::contact::Obstacle::Sphere { center: [0.0, 0.0, -0.04], radius: 0.03 }];
+    let mut sim = prepare(&s, published("satin1")).expect("scene");
+    let mut peak: f64 = 0.0;
+    for _ in 0..75 {
+        sim.step().expect("step");
+        peak = peak.max(sim.kinetic_energy());
+        assert!(sim.obstacle_penetration_m() == 0.0, "a vertex entered the sphere at t = {}", sim.time_s);
+    }
+    let centre = sim.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    eprintln!("drape: lowest {centre:.4} m, kinetic {:.2e} J (peak {peak:.2e} J)", sim.kinetic_energy());
+    assert!(centre < -0.05, "the cloth hangs over the sphere (lowest point {centre:.3} m)");
+    assert!(sim.kinetic_energy() < 0.05 * peak, "at rest: kinetic {:.2e} J vs peak {peak:.2e} J", sim.kinetic_energy());
+}
