@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The README's main command: yarnhom's pipeline on built-in defaults, printing where each
-# artifact went. Today: published and generated patterns, the Table 4.1 yarn models,
-# inspection, conversion (JSON, HDF5, .pyp), periodic tile solves, a rest-state relaxation, a
-# reduced sampling sweep and semantic diff. Later stages (fit -> simulate) join it as they land.
+# artifact went: published and generated patterns, the Table 4.1 yarn models, inspection,
+# conversion (JSON, HDF5, .pyp), periodic tile solves, a rest-state relaxation, a reduced
+# sampling sweep, the spline fit, a drape simulation recorded as an MCAP trace, the published
+# ARCSim-HYLC material imported and simulated, and semantic diff.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/setup.sh
@@ -39,10 +40,25 @@ yarnhom rve relax "$out/gen-stockinette.pattern.yh" --model table4.1:stock -o "$
 yarnhom rve solve "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --strain sx=0.2 \
   -o "$out/gen-stockinette-sx0.2.rvesolve.yh"
 
-echo "== sampling sweep (App. A.3.1, reduced plan: 9 values per 1D term, 3 x 3 per 2D term) -> $out/gen-stockinette.grid.yh"
-yarnhom rve sample "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --n1d 9 --n2d 3 \
+echo "== sampling sweep (App. A.3.1, reduced plan: 11 values per 1D term, 5 x 5 per 2D term) -> $out/gen-stockinette.grid.yh"
+yarnhom rve sample "$out/gen-stockinette.relaxed.pattern.yh" --model table4.1:stock --n1d 11 --n2d 5 \
   -o "$out/gen-stockinette.grid.yh"
 yarnhom convert "$out/gen-stockinette.grid.yh" --to hdf5 -o "$out/gen-stockinette.grid.h5"
+
+echo "== spline fit (Algorithms 3-5) -> $out/gen-stockinette.spline.yh, figures in $out/fit-figures/"
+yarnhom fit "$out/gen-stockinette.grid.yh" --stockinette -o "$out/gen-stockinette.spline.yh"
+yarnhom fit plot "$out/gen-stockinette.grid.yh" "$out/gen-stockinette.spline.yh" -o "$out/fit-figures"
+yarnhom fit export-arcsim "$out/gen-stockinette.spline.yh" -o "$out/gen-stockinette.arcsim.json"
+
+echo "== drape of our fitted stockinette over a sphere (coarse mesh, 0.5 s) -> $out/drape.mcap"
+yarnhom shell simulate drape --material "$out/gen-stockinette.spline.yh" --resolution 15 --steps-per-frame 1 \
+  --frames 30 -o "$out/drape.mcap" --obj-dir "$out/drape-obj"
+
+echo "== the published stockinette material (ARCSim-HYLC stock1.json) stretched along x -> $out/stock1-stretch-x.mcap"
+yarnhom fit import-arcsim ../shared/data/hylc-materials/stock1.json -o "$out/stock1.spline.yh"
+yarnhom fit compare "$out/stock1.spline.yh" "$out/gen-stockinette.spline.yh"
+yarnhom shell simulate stretch-x --material "$out/stock1.spline.yh" --resolution 15 --steps-per-frame 1 \
+  --frames 30 -o "$out/stock1-stretch-x.mcap"
 
 echo "== semantic diff: the HDF5 export against the original (equal), stockinette against rib (different)"
 yarnhom diff "$out/rib.pattern.yh" "$out/rib.pattern.h5"

@@ -5,7 +5,7 @@
 //! (A.37, A.38).
 
 use yarnhom_artifacts::grid::strain_values;
-use yarnhom_artifacts::{BicubicTerm, CubicTerm, FitSettings, Grid, GridTerm, Spline, SplineOrigin};
+use yarnhom_artifacts::{BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin};
 
 use crate::march::{
     bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d, quasiconvexify_1d,
@@ -271,6 +271,10 @@ pub struct TermError {
     /// RMS of (fit - data) divided by the RMS of the deformation energy `data - f0`: the
     /// stricter figure, blind to the constant.
     pub relative_rms_deformation: f64,
+    /// `relative_rms` over the samples the model is built to represent: for 2D terms other
+    /// than `sx,sy`, those without compression (`sx, sy >= 0`), whose combined response the
+    /// thesis leaves to the 1D terms (A.3.6); `None` when no such samples remain.
+    pub relative_rms_modelled: Option<f64>,
 }
 
 /// The fit's error on each term of its grid.
@@ -279,24 +283,33 @@ pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec
         .iter()
         .enumerate()
         .map(|(t, term)| {
-            let pairs: Vec<(f64, f64)> = grid
-                .samples
-                .iter()
-                .filter(|s| s.term as usize == t && s.converged)
-                .filter_map(|s| s.energy_density_j_m2.map(|e| (material.energy_at(&s.strain), e)))
-                .collect();
-            let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
-                (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt()
+            let samples: Vec<&GridSample> =
+                grid.samples.iter().filter(|s| s.term as usize == t && s.converged).collect();
+            let pairs = |keep: &dyn Fn(&GridSample) -> bool| -> Vec<(f64, f64)> {
+                samples
+                    .iter()
+                    .filter(|s| keep(s))
+                    .filter_map(|s| s.energy_density_j_m2.map(|e| (material.energy_at(&s.strain), e)))
+                    .collect()
             };
-            let error = rms(&|(fit, data)| fit - data);
+            let all = pairs(&|_| true);
+            let uncompressed = term.axes.len() == 1 || term.axes.as_slice() == POISSON_PAIR.map(|a| a as u8);
+            let modelled = pairs(&|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0));
             TermError {
                 term: term.name(),
-                samples: pairs.len(),
-                relative_rms: error / rms(&|(_, data)| *data),
-                relative_rms_deformation: error / rms(&|(_, data)| data - f0),
+                samples: all.len(),
+                relative_rms: relative_rms(&all, 0.0),
+                relative_rms_deformation: relative_rms(&all, f0),
+                relative_rms_modelled: (!modelled.is_empty()).then(|| relative_rms(&modelled, 0.0)),
             }
         })
         .collect()
+}
+
+/// RMS of (fit - data) over RMS of (data - offset), for `(fit, data)` pairs.
+fn relative_rms(pairs: &[(f64, f64)], offset: f64) -> f64 {
+    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt();
+    rms(&|(fit, data)| fit - data) / rms(&|(_, data)| data - offset)
 }
 
 #[cfg(test)]

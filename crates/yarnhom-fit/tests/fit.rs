@@ -1,0 +1,508 @@
+//! Acceptance tests of the fit (thesis Sec. 4.1, App. A.3) on synthetic grids sampled from a
+//! known, cloth-like energy with the thesis' plan shape: five 1D terms and the nine 2D terms of
+//! Alg. 3, non-uniform sampling as in Alg. 6 / Fig. A.2 (dense towards compression for `sx`,
+//! `sy`, dense around 0 for `sa`, `kx`, `ky`).
+
+use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values, strain_values};
+use yarnhom_artifacts::{FitSettings, Grid, GridSample, GridTerm, Spline, StrainSample};
+use yarnhom_fit::{FitError, SplineMaterial, fit_errors, fit_grid};
+
+/// Energy of the undeformed cloth (J/m²).
+pub const F0: f64 = 0.5;
+/// The curled rest curvature of the synthetic `kx` response (1/m), like stockinette.
+pub const KX_MIN: f64 = 40.0;
+/// The plan's lower and upper limits of `(sx, sa, sy, kx, ky)`.
+pub const LOWER: [f64; 5] = [-0.3, -0.75, -0.3, -200.0, -230.0];
+/// See [`LOWER`].
+pub const UPPER: [f64; 5] = [0.8, 0.75, 0.8, 200.0, 230.0];
+/// Samples per 1D term (symmetric axes get one more so that 0 is a sample).
+pub const N_1D: usize = 40;
+/// Samples per axis of a 2D term (symmetric axes get one more).
+pub const N_2D: usize = 12;
+/// The 2D terms of Alg. 3 line 8, in its order: 12, 13, 23, 1x, 2x, 3x, 1y, 2y, 3y.
+pub const PAIRS: [[u8; 2]; 9] = [[0, 1], [0, 2], [1, 2], [0, 3], [1, 3], [2, 3], [0, 4], [1, 4], [2, 4]];
+
+/// A cloth-like homogenized energy density (J/m²) of `(sx, sa, sy, kx, ky)`: stiffening in
+/// stretch and soft in compression, shear quadratic-quartic and symmetric, bending quadratic
+/// with a curled minimum at `kx = 40`, a Poisson-like `sx sy` coupling and stiffening of
+/// shear and bending under stretch.
+pub fn energy(v: [f64; 5]) -> f64 {
+    let [sx, sa, sy, kx, ky] = v;
+    let (px, py) = (sx.max(0.0), sy.max(0.0));
+    let stretch_x = if sx > 0.0 { 5.0 * sx * sx + 20.0 * sx.powi(4) } else { 1.5 * sx * sx };
+    let stretch_y = if sy > 0.0 { 4.0 * sy * sy + 15.0 * sy.powi(4) } else { 1.0 * sy * sy };
+    let shear = 2.0 * sa * sa + 6.0 * sa.powi(4);
+    let bend_x = 1.2e-4 * ((kx - KX_MIN).powi(2) - KX_MIN * KX_MIN);
+    let bend_y = 8e-5 * ky * ky;
+    let poisson = 3.0 * px * py;
+    let stretch_bend = 1.5 * px * (kx / 200.0).powi(2) + 1.2 * py * (ky / 230.0).powi(2);
+    let shear_stretch = sa * sa * (px + py);
+    F0 + stretch_x + stretch_y + shear + bend_x + bend_y + poisson + stretch_bend + shear_stretch
+}
+
+/// `n` values from `a` to `b`.
+fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect()
+}
+
+/// Alg. 6's sampling of an axis: `sx`, `sy` as `linspace((min+1)^(1/10), (max+1)^(1/10))^10 - 1`
+/// (dense towards compression), the others as `sgn(z) z²` of a linspace of `±sqrt(|limit|)`
+/// (dense around 0, `n + 1` values so 0 is one). The value nearest 0 is snapped to 0 and the
+/// ends are exact.
+pub fn axis_values(axis: usize, n: usize) -> Vec<f64> {
+    let (lo, hi) = (LOWER[axis], UPPER[axis]);
+    let mut values: Vec<f64> = if axis == 0 || axis == 2 {
+        linspace((lo + 1.0).powf(0.1), (hi + 1.0).powf(0.1), n)
+            .into_iter()
+            .map(|z| z.powi(10) - 1.0)
+            .collect()
+    } else {
+        let n = n + 1 - n % 2;
+        linspace(-(-lo).sqrt(), hi.sqrt(), n).into_iter().map(|z| z.signum() * z * z).collect()
+    };
+    let nearest =
+        (0..values.len()).min_by(|&a, &b| values[a].abs().total_cmp(&values[b].abs())).expect("values");
+    values[nearest] = 0.0;
+    let last = values.len() - 1;
+    (values[0], values[last]) = (lo, hi);
+    assert!(values.windows(2).all(|w| w[0] < w[1]), "axis {axis}: {values:?}");
+    values
+}
+
+/// A converged sample of `energy` at the plan's strain.
+fn sample(grid: &Grid, term: usize, index: [u32; 2], energy: &dyn Fn([f64; 5]) -> f64) -> GridSample {
+    let strain = grid.strain_at(term, index).expect("index in the plan");
+    GridSample {
+        term: term as u32,
+        index,
+        strain,
+        converged: true,
+        stop_reason: "converged".into(),
+        energy_density_j_m2: Some(energy(strain_values(&strain))),
+        stress: None,
+        iterations: 1,
+        positions_m: None,
+        edge_twist_rad: None,
+    }
+}
+
+/// The thesis' plan (five 1D terms, the nine 2D terms) sampled from `energy`, validated.
+pub fn synthetic_grid_of(energy: &dyn Fn([f64; 5]) -> f64) -> Grid {
+    let mut terms: Vec<GridTerm> =
+        (0..5).map(|a| GridTerm { axes: vec![a as u8], values: vec![axis_values(a, N_1D)] }).collect();
+    terms.extend(PAIRS.iter().map(|&[u, v]| GridTerm {
+        axes: vec![u, v],
+        values: vec![axis_values(u as usize, N_2D), axis_values(v as usize, N_2D)],
+    }));
+    let mut grid =
+        Grid { pattern: "synthetic".into(), model: "analytic".into(), terms, shard: None, samples: vec![] };
+    for t in 0..grid.terms.len() {
+        let n: Vec<usize> = grid.terms[t].values.iter().map(Vec::len).collect();
+        for i in 0..n[0] {
+            for j in 0..n.get(1).copied().unwrap_or(1) {
+                let s = sample(&grid, t, [i as u32, j as u32], energy);
+                grid.samples.push(s);
+            }
+        }
+    }
+    grid.validate().expect("the synthetic grid is valid");
+    grid
+}
+
+/// The plan sampled from [`energy`].
+pub fn synthetic_grid() -> Grid {
+    synthetic_grid_of(&energy)
+}
+
+fn fit(grid: &Grid) -> (Spline, SplineMaterial) {
+    let spline = fit_grid(grid, &FitSettings::default(), 0.3).expect("the synthetic grid fits");
+    spline.validate().expect("the fitted spline is valid");
+    let material = SplineMaterial::from(&spline);
+    (spline, material)
+}
+
+fn strain_along(axes: &[u8], values: &[f64]) -> StrainSample {
+    let mut v = [0.0; 5];
+    for (&a, &x) in axes.iter().zip(values) {
+        v[a as usize] = x;
+    }
+    strain_from_values(v)
+}
+
+/// Where `ys` (ordered) stops being unimodal: `None` if it does not rise more than `tol` above
+/// its running minimum before its global minimum, nor fall more than `tol` below its running
+/// maximum after it (plateaus are allowed); else the offending index.
+fn unimodality_violation(ys: &[f64], tol: f64) -> Option<usize> {
+    let m = (0..ys.len()).min_by(|&a, &b| ys[a].total_cmp(&ys[b]))?;
+    let mut low = ys[0];
+    for (i, &y) in ys.iter().enumerate().take(m + 1) {
+        if y > low + tol {
+            return Some(i);
+        }
+        low = low.min(y);
+    }
+    let mut high = ys[m];
+    for (i, &y) in ys.iter().enumerate().skip(m) {
+        if y < high - tol {
+            return Some(i);
+        }
+        high = high.max(y);
+    }
+    None
+}
+
+/// Number of strict local minima of `ys`, a run of equal values counting as one point.
+fn strict_local_minima(ys: &[f64]) -> usize {
+    let mut runs: Vec<f64> = Vec::new();
+    for &y in ys {
+        if runs.last() != Some(&y) {
+            runs.push(y);
+        }
+    }
+    let n = runs.len();
+    (0..n)
+        .filter(|&i| (i == 0 || runs[i - 1] > runs[i]) && (i + 1 == n || runs[i + 1] > runs[i]) && n > 1)
+        .filter(|&i| i != 0 && i + 1 != n)
+        .count()
+}
+
+/// The knots of a 1D term in strain units.
+fn knots_1d(spline: &Spline, axis: u8) -> Vec<f64> {
+    let term = spline.terms_1d.iter().find(|t| t.axis == axis).expect("a 1D term per axis");
+    term.knots.iter().map(|k| k * spline.strain_scale[axis as usize]).collect()
+}
+
+/// The widest knot spacing next to `x` (in strain units).
+fn knot_spacing_near(knots: &[f64], x: f64) -> f64 {
+    let k = (0..knots.len())
+        .min_by(|&a, &b| (knots[a] - x).abs().total_cmp(&(knots[b] - x).abs()))
+        .expect("knots");
+    let left = k.checked_sub(1).map_or(0.0, |l| knots[k] - knots[l]);
+    let right = knots.get(k + 1).map_or(0.0, |r| r - knots[k]);
+    left.max(right)
+}
+
+/// Each fitted 1D term must have exactly one local minimum over 1.5 times its sampled range, at
+/// 0 for in-plane and `ky` terms and near [`KX_MIN`] for `kx` (within a knot spacing); returns
+/// the violations.
+fn single_minimum_failures(grid: &Grid, spline: &Spline) -> Vec<String> {
+    let material = SplineMaterial::from(spline);
+    let mut failures = Vec::new();
+    for term in grid.terms.iter().filter(|t| t.axes.len() == 1) {
+        let axis = term.axes[0];
+        let (lo, hi) = (term.values[0][0], term.values[0][term.values[0].len() - 1]);
+        let xs = linspace(1.5 * lo, 1.5 * hi, 6001);
+        let ys: Vec<f64> = xs.iter().map(|&x| material.term_1d(axis as usize, x).expect("1D term")).collect();
+        let name = AXIS_NAMES[axis as usize];
+        if let Some(i) = unimodality_violation(&ys, 1e-12 * value_range(&ys)) {
+            failures.push(format!("f_{name} is not unimodal at {name} = {}", xs[i]));
+        }
+        let minima = strict_local_minima(&ys);
+        if minima != 1 {
+            failures.push(format!("f_{name} has {minima} strict interior local minima over 1.5x its range"));
+        }
+        let m = (0..ys.len()).min_by(|&a, &b| ys[a].total_cmp(&ys[b])).expect("samples");
+        let expected = if axis == 3 { KX_MIN } else { 0.0 };
+        let spacing = knot_spacing_near(&knots_1d(spline, axis), expected);
+        if (xs[m] - expected).abs() > spacing {
+            failures.push(format!(
+                "f_{name} has its minimum at {} instead of {expected} (knot spacing {spacing})",
+                xs[m]
+            ));
+        }
+    }
+    failures
+}
+
+fn value_range(ys: &[f64]) -> f64 {
+    ys.iter().cloned().fold(f64::NEG_INFINITY, f64::max) - ys.iter().cloned().fold(f64::INFINITY, f64::min)
+}
+
+/// The marched 2D terms (all but `f_{sx,sy}`, A.3.4) must be quasiconvex: the fitted energy on
+/// the term's plane, `f0 + f_u + f_v + f_uv` (the regularized `f*` of A.3.6 that the marching
+/// acts on), has at most one local minimum along every line through the term's knots, over 1.5
+/// times the sampled range (plateaus allowed, up to 1e-6 of the energy range of the plane);
+/// returns the violations.
+fn quasiconvexity_failures(grid: &Grid, spline: &Spline) -> Vec<String> {
+    let material = SplineMaterial::from(spline);
+    let mut failures = Vec::new();
+    for term in spline.terms_2d.iter().filter(|t| t.axes != [0, 2]) {
+        let axes = [term.axes[0], term.axes[1]];
+        let [su, sv] = [spline.strain_scale[axes[0] as usize], spline.strain_scale[axes[1] as usize]];
+        let grid_term = grid.terms.iter().find(|t| t.axes == axes).expect("sampled term");
+        let (u_lo, u_hi) = (grid_term.values[0][0], *grid_term.values[0].last().expect("values"));
+        let (v_lo, v_hi) = (grid_term.values[1][0], *grid_term.values[1].last().expect("values"));
+        let on_plane = |u: f64, v: f64| material.energy_at(&strain_along(&axes, &[u, v]));
+        let (u_line, v_line) =
+            (linspace(1.5 * u_lo, 1.5 * u_hi, 3001), linspace(1.5 * v_lo, 1.5 * v_hi, 3001));
+        let plane: Vec<f64> = u_line
+            .iter()
+            .step_by(75)
+            .flat_map(|&u| v_line.iter().step_by(75).map(move |&v| (u, v)))
+            .map(|(u, v)| on_plane(u, v))
+            .collect();
+        let tol = 1e-6 * value_range(&plane);
+        let name = format!("{},{}", AXIS_NAMES[axes[0] as usize], AXIS_NAMES[axes[1] as usize]);
+        for v in term.v_knots.iter().map(|k| k * sv) {
+            let ys: Vec<f64> = u_line.iter().map(|&u| on_plane(u, v)).collect();
+            if let Some(i) = unimodality_violation(&ys, tol) {
+                failures
+                    .push(format!("{name}: along the line v = {v}, a second minimum near u = {}", u_line[i]));
+            }
+        }
+        for u in term.u_knots.iter().map(|k| k * su) {
+            let ys: Vec<f64> = v_line.iter().map(|&v| on_plane(u, v)).collect();
+            if let Some(i) = unimodality_violation(&ys, tol) {
+                failures
+                    .push(format!("{name}: along the line u = {u}, a second minimum near v = {}", v_line[i]));
+            }
+        }
+    }
+    failures
+}
+
+/// `f_sa(x) = f_sa(-x)` and `Ψ(sa = x) = Ψ(sa = -x)` to 1e-9 relative, and the 2D terms with
+/// `sa` even in it; returns the violations.
+fn shear_asymmetries(spline: &Spline) -> Vec<String> {
+    let material = SplineMaterial::from(spline);
+    let mut failures = Vec::new();
+    let limit = 1.5 * UPPER[1];
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    for x in linspace(0.0, limit, 1001) {
+        let (plus, minus) = (material.term_1d(1, x).expect("f_sa"), material.term_1d(1, -x).expect("f_sa"));
+        if !close(plus, minus) {
+            failures.push(format!("f_sa({x}) = {plus}, f_sa(-{x}) = {minus}"));
+        }
+        let total = |sa: f64| material.energy_at(&strain_along(&[1], &[sa]));
+        let (plus, minus) = (total(x), total(-x));
+        if !close(plus, minus) {
+            failures.push(format!("Ψ(sa = ±{x}) = {plus}, {minus}"));
+        }
+    }
+    for term in spline.terms_2d.iter().filter(|t| t.axes.contains(&1)) {
+        let axes = [term.axes[0] as usize, term.axes[1] as usize];
+        // the position of sa among the term's axes, and the other axis
+        let k = if axes[0] == 1 { 0 } else { 1 };
+        let other = axes[1 - k];
+        for y in linspace(1.5 * LOWER[other], 1.5 * UPPER[other], 31) {
+            for x in linspace(0.0, limit, 31) {
+                let at = |sa: f64| {
+                    let (u, v) = if k == 0 { (sa, y) } else { (y, sa) };
+                    material.term_2d(axes, u, v).expect("2D term")
+                };
+                let (plus, minus) = (at(x), at(-x));
+                if (plus - minus).abs() > 1e-9 * plus.abs().max(minus.abs()).max(1e-12) {
+                    failures.push(format!(
+                        "f_{axes:?} at sa = ±{x}, {} = {y}: {plus} vs {minus}",
+                        AXIS_NAMES[other]
+                    ));
+                }
+            }
+        }
+    }
+    failures
+}
+
+/// Each 1D term increases strictly away from the minimum beyond its first and last knots, over
+/// one knot range; returns the violations.
+fn extrapolation_failures(spline: &Spline) -> Vec<String> {
+    let material = SplineMaterial::from(spline);
+    let mut failures = Vec::new();
+    for term in &spline.terms_1d {
+        let knots = knots_1d(spline, term.axis);
+        let (first, last) = (knots[0], knots[knots.len() - 1]);
+        let f = |x: f64| material.term_1d(term.axis as usize, x).expect("1D term");
+        let name = AXIS_NAMES[term.axis as usize];
+        for (end, outward) in [(last, 1.0), (first, -1.0)] {
+            let mut previous = f(end);
+            for d in linspace(0.0, last - first, 101).into_iter().skip(1) {
+                let x = end + outward * d;
+                let y = f(x);
+                if y <= previous {
+                    failures.push(format!("f_{name} does not increase outward at {x}: {y} after {previous}"));
+                    break;
+                }
+                previous = y;
+            }
+        }
+    }
+    failures
+}
+
+#[test]
+fn the_fit_reproduces_the_synthetic_energy() {
+    let grid = synthetic_grid();
+    let (spline, material) = fit(&grid);
+    assert_eq!(spline.terms_1d.len(), 5);
+    assert_eq!(spline.terms_2d.len(), 9);
+    assert_eq!(spline.rest_energy_density_j_m2, F0);
+    let errors = fit_errors(&grid, &material, spline.rest_energy_density_j_m2);
+    eprintln!("{:<7} {:>7} {:>13} {:>25}", "term", "samples", "relative_rms", "relative_rms_deformation");
+    for e in &errors {
+        eprintln!(
+            "{:<7} {:>7} {:>13.4e} {:>25.4e}",
+            e.term, e.samples, e.relative_rms, e.relative_rms_deformation
+        );
+    }
+    let mut failures = Vec::new();
+    for (e, term) in errors.iter().zip(&grid.terms) {
+        let bound = if term.axes.len() == 1 { 0.05 } else { 0.10 };
+        if e.relative_rms.is_nan() || e.relative_rms >= bound {
+            failures.push(format!("{}: relative RMS {:.4} >= {bound}", e.term, e.relative_rms));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn fitted_1d_terms_have_a_single_minimum_where_the_energy_has_it() {
+    let grid = synthetic_grid();
+    let (spline, _) = fit(&grid);
+    let failures = single_minimum_failures(&grid, &spline);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn marched_2d_terms_have_at_most_one_minimum_per_grid_line() {
+    let grid = synthetic_grid();
+    let (spline, _) = fit(&grid);
+    let failures = quasiconvexity_failures(&grid, &spline);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn the_fit_is_symmetric_in_shear() {
+    let (spline, _) = fit(&synthetic_grid());
+    let failures = shear_asymmetries(&spline);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn extrapolation_increases_away_from_the_minimum() {
+    let (spline, _) = fit(&synthetic_grid());
+    let failures = extrapolation_failures(&spline);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The checks above fail on a spline with the defects they look for.
+#[test]
+fn the_checks_detect_defective_splines() {
+    let grid = synthetic_grid();
+    let (spline, _) = fit(&grid);
+    let term_1d = |s: &mut Spline, axis: u8| -> usize {
+        s.terms_1d.iter().position(|t| t.axis == axis).expect("1D term")
+    };
+
+    // A dip at the second-to-last knot of f_sx: a second minimum.
+    let mut bad = spline.clone();
+    let t = term_1d(&mut bad, 0);
+    let n = bad.terms_1d[t].values.len();
+    bad.terms_1d[t].values[n - 2] -= 20.0;
+    assert!(!single_minimum_failures(&grid, &bad).is_empty());
+
+    // f_kx with its minimum moved two knots left of 0.
+    let mut bad = spline.clone();
+    let t = term_1d(&mut bad, 3);
+    let zero = bad.terms_1d[t].knots.iter().position(|&k| k == 0.0).expect("knot at 0");
+    bad.terms_1d[t].values[zero - 2] -= 5.0;
+    assert!(single_minimum_failures(&grid, &bad).iter().any(|f| f.contains("instead of 40")));
+
+    // A hole in f_{sx,kx} off the axes: a second minimum along a grid line.
+    let mut bad = spline.clone();
+    let t = bad.terms_2d.iter().position(|t| t.axes == [0, 3]).expect("sx,kx");
+    let nu = bad.terms_2d[t].u_knots.len();
+    bad.terms_2d[t].values[nu + nu - 2] -= 20.0;
+    assert!(!quasiconvexity_failures(&grid, &bad).is_empty());
+
+    // An asymmetric f_sa and f_{sx,sa}.
+    let mut bad = spline.clone();
+    let t = term_1d(&mut bad, 1);
+    bad.terms_1d[t].values[1] += 0.01;
+    let t = bad.terms_2d.iter().position(|t| t.axes == [0, 1]).expect("sx,sa");
+    let nu = bad.terms_2d[t].u_knots.len();
+    bad.terms_2d[t].values[nu + nu - 2] += 0.01;
+    let failures = shear_asymmetries(&bad);
+    assert!(
+        failures.iter().any(|f| f.starts_with("f_sa")) && failures.iter().any(|f| f.starts_with("f_[0, 1]"))
+    );
+
+    // f_ky extrapolated downhill beyond its last knot.
+    let mut bad = spline.clone();
+    let t = term_1d(&mut bad, 4);
+    *bad.terms_1d[t].slopes.last_mut().expect("slopes") = -0.5;
+    assert!(!extrapolation_failures(&bad).is_empty());
+}
+
+#[test]
+fn too_few_samples_and_a_missing_rest_sample_are_errors() {
+    let mut grid = synthetic_grid();
+    // Keep 3 converged samples of the sy term.
+    let sy = grid.terms.iter().position(|t| t.axes == [2]).expect("sy term") as u32;
+    for s in grid.samples.iter_mut().filter(|s| s.term == sy).skip(3) {
+        s.converged = false;
+        s.stop_reason = "iteration_limit".into();
+        s.energy_density_j_m2 = None;
+    }
+    grid.validate().expect("valid");
+    assert_eq!(
+        fit_grid(&grid, &FitSettings::default(), 0.3),
+        Err(FitError::TooFewSamples { term: "sy".into(), converged: 3 })
+    );
+
+    let mut grid = synthetic_grid();
+    for s in grid.samples.iter_mut().filter(|s| strain_values(&s.strain).iter().all(|&v| v == 0.0)) {
+        s.converged = false;
+        s.stop_reason = "line_search_failed".into();
+        s.energy_density_j_m2 = None;
+    }
+    grid.validate().expect("valid");
+    assert_eq!(fit_grid(&grid, &FitSettings::default(), 0.3), Err(FitError::NoRestSample));
+}
+
+/// Deterministic pseudo-random numbers in `[0, 1)` (xorshift64).
+struct XorShift(u64);
+
+impl XorShift {
+    fn unit(&mut self) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+#[test]
+fn noise_in_compression_is_regularized_away() {
+    let clean = synthetic_grid();
+    let mut noisy = clean.clone();
+    let mut rng = XorShift(0x9E37_79B9_7F4A_7C15);
+    let amplitude = 0.04;
+    for s in noisy.samples.iter_mut().filter(|s| s.strain.sx < 0.0 || s.strain.sy < 0.0) {
+        let e = s.energy_density_j_m2.as_mut().expect("converged");
+        *e *= 1.0 + amplitude * (2.0 * rng.unit() - 1.0);
+    }
+    noisy.validate().expect("valid");
+    let (spline, material) = fit(&noisy);
+    let failures = single_minimum_failures(&noisy, &spline);
+    assert!(failures.is_empty(), "{failures:#?}");
+    // Errors against the noiseless truth.
+    let errors = fit_errors(&clean, &material, spline.rest_energy_density_j_m2);
+    eprintln!("with {}% noise in compression, against the noiseless energy:", amplitude * 100.0);
+    eprintln!("{:<7} {:>7} {:>13} {:>25}", "term", "samples", "relative_rms", "relative_rms_deformation");
+    for e in &errors {
+        eprintln!(
+            "{:<7} {:>7} {:>13.4e} {:>25.4e}",
+            e.term, e.samples, e.relative_rms, e.relative_rms_deformation
+        );
+    }
+    for (e, term) in errors.iter().zip(&clean.terms) {
+        if term.axes.len() == 1 {
+            assert!(
+                e.relative_rms < 0.05,
+                "{}: relative RMS {:.4} against the truth",
+                e.term,
+                e.relative_rms
+            );
+        }
+    }
+}
