@@ -32,8 +32,9 @@ pub enum FitCommand {
     /// Figures of a fit against its grid: per 1D term data, fit and control points (Fig. 4.4);
     /// per 2D term data, sum of 1D fits, residual, fit and error heat maps (Fig. 4.5). SVG.
     Plot(PlotArgs),
-    /// Compare two spline materials term by term on the sampled strain ranges (e.g. our fit of
-    /// a pattern against the published fit of it): RMS and largest differences per 1D term.
+    /// Compare two spline materials' 1D terms over the strains both were fitted on (e.g. our fit
+    /// of a pattern against the published fit of it): RMS of each, of their difference, and the
+    /// correlation of their shapes.
     Compare(CompareArgs),
 }
 
@@ -212,15 +213,24 @@ fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// Strains along each 1D term for comparisons: the first spline's normalization range.
+/// The strain range `[lo, hi]` a spline's 1D term has knots over (its fitted range).
+fn knot_range(spline: &Spline, axis: usize) -> Option<[f64; 2]> {
+    let term = spline.terms_1d.iter().find(|t| t.axis as usize == axis)?;
+    let scale = spline.strain_scale[axis];
+    Some([term.knots[0] * scale, term.knots[term.knots.len() - 1] * scale])
+}
+
+/// Two splines' 1D terms over the strains both were fitted on (the overlap of their knot
+/// ranges), each relative to its value at zero strain.
 fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
     let (a, b) = (load_spline(&args.first)?, load_spline(&args.second)?);
     let (ma, mb) = (SplineMaterial::from(&a), SplineMaterial::from(&b));
-    println!("1D terms (energy relative to rest, J/m²) over ±strain scale of '{}':", a.name);
-    println!("  term   RMS first  RMS second  RMS difference  shape correlation");
+    println!("1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:", a.name, b.name);
+    println!("  term  range                 RMS first  RMS second  RMS difference  shape correlation");
     for axis in 0..5 {
-        let scale = a.strain_scale[axis];
-        let xs: Vec<f64> = (0..=100).map(|k| scale * (-1.0 + 0.02 * f64::from(k))).collect();
+        let (Some(ra), Some(rb)) = (knot_range(&a, axis), knot_range(&b, axis)) else { continue };
+        let (lo, hi) = (ra[0].max(rb[0]), ra[1].min(rb[1]));
+        let xs: Vec<f64> = (0..=100).map(|k| lo + (hi - lo) * f64::from(k) / 100.0).collect();
         let curve = |m: &SplineMaterial| -> Option<Vec<f64>> {
             let zero = m.term_1d(axis, 0.0)?;
             xs.iter().map(|&x| m.term_1d(axis, x).map(|v| v - zero)).collect()
@@ -229,8 +239,10 @@ fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
         let diff: Vec<f64> = ca.iter().zip(&cb).map(|(x, y)| x - y).collect();
         println!(
-            "  {:4} {:11.4e} {:11.4e} {:15.4e} {:18.3}",
+            "  {:4}  [{:8.3}, {:8.3}]  {:10.4e} {:11.4e} {:15.4e} {:18.3}",
             yarnhom_artifacts::grid::AXIS_NAMES[axis],
+            lo,
+            hi,
             rms(&ca),
             rms(&cb),
             rms(&diff),
