@@ -13,6 +13,8 @@ use plotters::prelude::*;
 use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values};
 use yarnhom_artifacts::{Grid, GridTerm, Spline};
 use yarnhom_fit::SplineMaterial;
+// The colour scale of Fig. 4.5 is the symlog of App. A.3.3.
+use yarnhom_fit::mls::{symexp, symlog};
 
 /// Size of a 1D figure (px).
 const SIZE_1D: (u32, u32) = (820, 580);
@@ -68,16 +70,6 @@ fn axis_label(axis: u8) -> String {
 }
 
 const ENERGY_LABEL: &str = "energy density Ψ [J/m²]";
-
-/// `sgn(x) ln(1 + |x|)`, the colour scale of Fig. 4.5 (and of App. A.3.3).
-fn symlog(x: f64) -> f64 {
-    x.signum() * x.abs().ln_1p()
-}
-
-/// The inverse of [`symlog`].
-fn symexp(x: f64) -> f64 {
-    x.signum() * x.abs().exp_m1()
-}
 
 /// A number for a tick label: short, fixed for moderate magnitudes, else scientific.
 fn format_value(x: f64) -> String {
@@ -476,61 +468,13 @@ fn draw_color_bar(area: &DrawingArea<SVGBackend<'_>, Shift>, scale: ColorScale) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use yarnhom_artifacts::grid::strain_values;
-    use yarnhom_artifacts::{FitSettings, GridSample};
+    use yarnhom_artifacts::FitSettings;
 
-    /// A cloth-like energy: stiffening stretch, soft compression, symmetric shear, curling
-    /// bending with its minimum at `kx = 40`, stretch-bending coupling.
-    fn energy(v: [f64; 5]) -> f64 {
-        let [sx, sa, _, kx, _] = v;
-        let stretch = if sx > 0.0 { 6.0 * sx * sx + 25.0 * sx.powi(4) } else { 1.5 * sx * sx };
-        let shear = 2.0 * sa * sa + 6.0 * sa.powi(4);
-        let bend = 1.5e-4 * ((kx - 40.0).powi(2) - 1600.0);
-        0.5 + stretch + shear + bend + 2.0 * sx.max(0.0) * (kx / 200.0).powi(2) + sa * sa * sx.max(0.0)
-    }
-
+    /// The synthetic thesis-shaped grid, with one failed solve in the `sx,kx` term (drawn grey).
     fn grid() -> Grid {
-        let sx = vec![-0.3, -0.2, -0.12, -0.05, 0.0, 0.1, 0.25, 0.4, 0.6, 0.8];
-        let sa = vec![-0.75, -0.45, -0.2, -0.05, 0.0, 0.05, 0.2, 0.45, 0.75];
-        let kx = vec![-200.0, -120.0, -60.0, -20.0, 0.0, 20.0, 60.0, 120.0, 200.0];
-        let terms = vec![
-            GridTerm { axes: vec![0], values: vec![sx.clone()] },
-            GridTerm { axes: vec![1], values: vec![sa.clone()] },
-            GridTerm { axes: vec![3], values: vec![kx.clone()] },
-            GridTerm { axes: vec![0, 1], values: vec![sx.clone(), sa] },
-            GridTerm { axes: vec![0, 3], values: vec![sx, kx] },
-        ];
-        let mut grid = Grid {
-            pattern: "synthetic".into(),
-            model: "test".into(),
-            terms,
-            shard: None,
-            samples: Vec::new(),
-        };
-        for t in 0..grid.terms.len() {
-            let n: Vec<usize> = grid.terms[t].values.iter().map(Vec::len).collect();
-            for i in 0..n[0] {
-                for j in 0..n.get(1).copied().unwrap_or(1) {
-                    let index = [i as u32, j as u32];
-                    let strain = grid.strain_at(t, index).expect("in the plan");
-                    grid.samples.push(GridSample {
-                        term: t as u32,
-                        index,
-                        strain,
-                        converged: true,
-                        stop_reason: "converged".into(),
-                        energy_density_j_m2: Some(energy(strain_values(&strain))),
-                        stress: None,
-                        iterations: 1,
-                        positions_m: None,
-                        edge_twist_rad: None,
-                    });
-                }
-            }
-        }
-        // One failed solve in a 2D term, drawn grey.
-        let failed =
-            grid.samples.iter_mut().rfind(|s| s.term == 4 && s.index == [9, 8]).expect("corner sample");
+        let mut grid = yarnhom_fit::synthetic::synthetic_grid();
+        let term = grid.terms.iter().position(|t| t.axes == [0, 3]).expect("sx,kx term") as u32;
+        let failed = grid.samples.iter_mut().rfind(|s| s.term == term).expect("corner sample");
         failed.converged = false;
         failed.stop_reason = "iteration_limit".into();
         failed.energy_density_j_m2 = None;
@@ -547,7 +491,12 @@ mod tests {
         let paths = plot_fit(&grid, &spline, &out).expect("plots");
         let names: Vec<String> =
             paths.iter().map(|p| p.file_name().expect("file").to_string_lossy().into_owned()).collect();
-        assert_eq!(names, ["1d-sx.svg", "1d-sa.svg", "1d-kx.svg", "2d-sx-sa.svg", "2d-sx-kx.svg"]);
+        let expected: Vec<String> = grid
+            .terms
+            .iter()
+            .map(|t| format!("{}d-{}.svg", t.axes.len(), t.name().replace(',', "-")))
+            .collect();
+        assert_eq!(names, expected);
         for (path, term) in paths.iter().zip(&grid.terms) {
             let svg = std::fs::read_to_string(path).expect("readable");
             assert!(svg.starts_with("<svg"), "{}: {}", path.display(), &svg[..svg.len().min(80)]);
@@ -569,7 +518,7 @@ mod tests {
                 );
             }
         }
-        let with_failure = std::fs::read_to_string(&paths[4]).expect("readable");
+        let with_failure = std::fs::read_to_string(out.join("2d-sx-kx.svg")).expect("readable");
         assert!(with_failure.contains("#BBBBBB"), "the failed sample is grey");
     }
 

@@ -8,6 +8,7 @@
 //! - [`residual`]: residualization (A.37, A.38).
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
 //! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
+//! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
 //! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
 
 pub mod curvature;
@@ -19,6 +20,7 @@ pub mod mls;
 pub mod monotone_bicubic;
 pub mod monotone_cubic;
 pub mod residual;
+pub mod synthetic;
 
 pub use fit::{FitError, TermError, fit_errors, fit_grid};
 pub use material::{EnergyJet, SplineMaterial};
