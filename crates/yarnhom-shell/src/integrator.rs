@@ -209,12 +209,7 @@ impl Simulation {
         let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new() };
         let mut stats = StepStats { newton_iterations: 0, residual_n: 0.0, line_search_steps: 0, converged: false, wall_time_s: 0.0 };
         for iteration in 0..self.dynamics.max_newton_iterations {
-            let mut a = self.assemble(&x, &terms);
-            if iteration == 0 && self.dynamics.stiffness_damping > 0.0 {
-                // K_n: the clamped elastic Hessian at the start of the step.
-                terms.stiffness_damping = self.elastic_hessian(&x);
-                self.add_damping(&x, &terms, &mut a);
-            }
+            let mut a = self.assemble(&x, &mut terms, iteration == 0);
             self.remove_fixed(&mut a);
             stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
             self.solver
@@ -299,11 +294,16 @@ impl Simulation {
         phi
     }
 
-    /// Gradient and Newton matrix of `Φ` (without stiffness damping, added on iteration 0).
-    fn assemble(&self, x: &[Vector3<f64>], terms: &StepTerms) -> Assembly {
+    /// Gradient and Newton matrix of `Φ`. On the step's first iteration the clamped elastic
+    /// Hessian is also kept, scaled by `β`, as the stiffness damping matrix `β K_n`.
+    fn assemble(&self, x: &[Vector3<f64>], terms: &mut StepTerms, first: bool) -> Assembly {
         let h = self.dynamics.dt_s;
         let mut a = Assembly::new(3 * x.len());
         self.model.assemble(x, true, &mut a);
+        let beta = self.dynamics.stiffness_damping;
+        if first && beta > 0.0 {
+            terms.stiffness_damping = a.triplets.iter().map(|&(i, j, v)| (i, j, beta * v)).collect();
+        }
         let g = Vector3::from(self.dynamics.gravity);
         let alpha = self.dynamics.mass_damping;
         for (i, p) in x.iter().enumerate() {
@@ -336,14 +336,6 @@ impl Simulation {
             self.add_damping(x, terms, &mut a);
         }
         a
-    }
-
-    /// The clamped elastic Hessian at `x`, scaled by `β`.
-    fn elastic_hessian(&self, x: &[Vector3<f64>]) -> Vec<(usize, usize, f64)> {
-        let mut a = Assembly::new(3 * x.len());
-        self.model.assemble(x, true, &mut a);
-        let beta = self.dynamics.stiffness_damping;
-        a.triplets.into_iter().map(|(i, j, v)| (i, j, beta * v)).collect()
     }
 
     /// `β K_n (x - x_n) / h` into the gradient and `β K_n / h` into the matrix.
