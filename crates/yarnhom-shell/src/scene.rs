@@ -172,7 +172,12 @@ impl Scene {
         if BUILTINS.contains(&spec) {
             return Self::builtin(spec);
         }
-        let text = std::fs::read_to_string(spec).map_err(|e| SceneError::Parse(format!("cannot read scene '{spec}': {e}")))?;
+        let text = std::fs::read_to_string(spec).map_err(|e| {
+            SceneError::Parse(format!(
+                "'{spec}' is neither a built-in scene ({}) nor a readable scene file: {e}",
+                BUILTINS.join(", ")
+            ))
+        })?;
         let name = std::path::Path::new(spec).file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
         let stripped = yarnhom_artifacts::arcsim::strip_comments(&text);
         let value: serde_json::Value =
