@@ -130,7 +130,7 @@ impl Scene {
                 self_stiffness_n_m: 0.0,
             },
             max_newton_iterations: 30,
-            tolerance_m: 1e-5,
+            tolerance_m: 1e-4,
         };
         let bar = |side: u8, motion: usize| HandleSpec::Bar { side, length: 0.67, width: 0.07, inset: 0.16, motion: Some(motion) };
         let pull = |d: [f64; 3]| vec![(0.0, [0.0; 3]), (0.4, d)];

@@ -1,0 +1,32 @@
+//! Newton convergence of the shell integrator on a built-in scene with a published material:
+//! per step the iterations, line-search halvings, final residual and wall time.
+//! `cargo run --release -p yarnhom-shell --example newton_probe -- SCENE MATERIAL N STEPS [TOLERANCE_M]`
+
+use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::Scene;
+use yarnhom_shell::ShellMaterial;
+use yarnhom_shell::simulate::prepare;
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let scene_name = args.get(1).map_or("stretch-x", String::as_str);
+    let material = args.get(2).map_or("stock1", String::as_str);
+    let n: usize = args.get(3).and_then(|a| a.parse().ok()).unwrap_or(25);
+    let steps: usize = args.get(4).and_then(|a| a.parse().ok()).unwrap_or(20);
+    let path = format!("{}/../../../shared/data/hylc-materials/{material}.json", env!("CARGO_MANIFEST_DIR"));
+    let spline = read_spline(std::path::Path::new(&path)).expect("published material");
+    let mut scene = Scene::builtin(scene_name).expect("built-in scene");
+    scene.vertices = [n, n];
+    if let Some(tolerance) = args.get(5).and_then(|a| a.parse().ok()) {
+        scene.tolerance_m = tolerance;
+    }
+    let mut sim = prepare(&scene, ShellMaterial::spline(SplineMaterial::from(&spline))).expect("scene");
+    for _ in 0..steps {
+        let s = sim.step().expect("step");
+        println!(
+            "t {:.4} s: {:2} Newton iterations, {:2} halvings, residual {:.2e} N, converged {}, {:.3} s",
+            sim.time_s, s.newton_iterations, s.line_search_steps, s.residual_n, s.converged, s.wall_time_s
+        );
+    }
+}
