@@ -14,7 +14,9 @@ use yarnhom_shell::{Scene, ShellMaterial};
 
 fn stock() -> ShellMaterial {
     let path = format!("{}/../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
-    ShellMaterial::spline(SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published material")))
+    ShellMaterial::spline(SplineMaterial::from(
+        &read_spline(std::path::Path::new(&path)).expect("published material"),
+    ))
 }
 
 fn bench_steps(c: &mut Criterion) {

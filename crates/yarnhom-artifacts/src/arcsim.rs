@@ -95,7 +95,10 @@ impl ArcsimMaterial {
         if material.strain_shift != STRAIN_SHIFT {
             return Err(format_error(
                 0,
-                format!("strain shift must be {STRAIN_SHIFT:?} (stretch ratio minus 1), got {:?}", material.strain_shift),
+                format!(
+                    "strain shift must be {STRAIN_SHIFT:?} (stretch ratio minus 1), got {:?}",
+                    material.strain_shift
+                ),
             ));
         }
         Ok(material)
@@ -112,7 +115,12 @@ impl ArcsimMaterial {
                 .coeffs
                 .terms_1d
                 .iter()
-                .map(|t| CubicTerm { axis: t.k, knots: t.t.clone(), values: t.p.clone(), slopes: t.m.clone() })
+                .map(|t| CubicTerm {
+                    axis: t.k,
+                    knots: t.t.clone(),
+                    values: t.p.clone(),
+                    slopes: t.m.clone(),
+                })
                 .collect(),
             terms_2d: self
                 .coeffs
@@ -145,7 +153,12 @@ impl ArcsimMaterial {
                 terms_1d: spline
                     .terms_1d
                     .iter()
-                    .map(|t| Term1d { k: t.axis, t: t.knots.clone(), p: t.values.clone(), m: t.slopes.clone() })
+                    .map(|t| Term1d {
+                        k: t.axis,
+                        t: t.knots.clone(),
+                        p: t.values.clone(),
+                        m: t.slopes.clone(),
+                    })
                     .collect(),
                 terms_2d: spline
                     .terms_2d
@@ -167,7 +180,8 @@ impl ArcsimMaterial {
 
     /// The JSON text ARCSim-HYLC reads.
     pub fn to_json(&self) -> Result<String> {
-        serde_json::to_string_pretty(self).map_err(|e| Error::Encode { what: "ARCSim-HYLC JSON", message: e.to_string() })
+        serde_json::to_string_pretty(self)
+            .map_err(|e| Error::Encode { what: "ARCSim-HYLC JSON", message: e.to_string() })
     }
 }
 
@@ -188,8 +202,13 @@ pub fn strip_comments(text: &str) -> String {
     while let Some(c) = chars.next() {
         if in_string {
             out.push(c);
-            escaped = c == '\\' && !escaped;
-            in_string = !(c == '"' && !escaped);
+            if escaped {
+                escaped = false;
+            } else if c == '\\' {
+                escaped = true;
+            } else if c == '"' {
+                in_string = false;
+            }
             continue;
         }
         match (c, chars.peek()) {
@@ -248,8 +267,18 @@ mod tests {
         let spline = material.to_spline("fit", "fit.json").expect("valid");
         assert_eq!(spline.terms_1d[0].values, vec![0.0, 1.0, 4.0]);
         assert_eq!(spline.terms_2d[0].axes, [0, 3]);
-        let back = ArcsimMaterial::parse(&ArcsimMaterial::from_spline(&spline).to_json().expect("json")).expect("parses");
+        let back = ArcsimMaterial::parse(&ArcsimMaterial::from_spline(&spline).to_json().expect("json"))
+            .expect("parses");
         assert_eq!(back.to_spline("fit", "fit.json").expect("valid"), spline);
+    }
+
+    #[test]
+    fn comments_are_stripped_outside_strings_only() {
+        let text = "{\"a\": \"x \\\" // y\", // gone\n /* gone\n too */ \"b\": 1}";
+        let value: serde_json::Value = serde_json::from_str(&strip_comments(text)).expect("json");
+        assert_eq!(value["a"], "x \" // y");
+        assert_eq!(value["b"], 1);
+        assert_eq!(strip_comments(text).lines().count(), 3, "line breaks are kept");
     }
 
     #[test]
@@ -263,7 +292,8 @@ mod tests {
 
     #[test]
     fn every_published_material_imports() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/hylc-materials");
+        let dir =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/hylc-materials");
         let mut count = 0;
         for entry in std::fs::read_dir(&dir).expect("the published materials").flatten() {
             let path = entry.path();

@@ -263,9 +263,12 @@ pub fn diff_splines(a: &Spline, b: &Spline, tol: Tolerance) -> Diff {
         let name = ta.name();
         match b.terms_2d.iter().find(|tb| tb.axes == ta.axes) {
             Some(tb) if tb.u_knots == ta.u_knots && tb.v_knots == ta.v_knots => {
-                for (field, x, y) in
-                    [("values", &ta.values, &tb.values), ("du", &ta.du, &tb.du), ("dv", &ta.dv, &tb.dv), ("duv", &ta.duv, &tb.duv)]
-                {
+                for (field, x, y) in [
+                    ("values", &ta.values, &tb.values),
+                    ("du", &ta.du, &tb.du),
+                    ("dv", &ta.dv, &tb.dv),
+                    ("duv", &ta.duv, &tb.duv),
+                ] {
                     d.values(&format!("f_{{{name}}}.{field}"), x, y, tol);
                 }
             }
@@ -273,8 +276,10 @@ pub fn diff_splines(a: &Spline, b: &Spline, tol: Tolerance) -> Diff {
             None => d.structural.push(format!("f_{{{name}}}: only in the first")),
         }
     }
-    let only_second_1d = b.terms_1d.iter().filter(|tb| !a.terms_1d.iter().any(|ta| ta.axis == tb.axis)).count();
-    let only_second_2d = b.terms_2d.iter().filter(|tb| !a.terms_2d.iter().any(|ta| ta.axes == tb.axes)).count();
+    let only_second_1d =
+        b.terms_1d.iter().filter(|tb| !a.terms_1d.iter().any(|ta| ta.axis == tb.axis)).count();
+    let only_second_2d =
+        b.terms_2d.iter().filter(|tb| !a.terms_2d.iter().any(|ta| ta.axes == tb.axes)).count();
     if only_second_1d + only_second_2d > 0 {
         d.structural.push(format!("{} terms only in the second", only_second_1d + only_second_2d));
     }

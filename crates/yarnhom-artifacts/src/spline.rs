@@ -135,13 +135,19 @@ impl Spline {
         for (t, term) in self.terms_1d.iter().enumerate() {
             term.validate(&format!("terms_1d[{t}]"))?;
             if let Some(first) = self.terms_1d[..t].iter().position(|x| x.axis == term.axis) {
-                return Err(ValidationError::new(format!("terms_1d[{t}]"), format!("repeats terms_1d[{first}]")));
+                return Err(ValidationError::new(
+                    format!("terms_1d[{t}]"),
+                    format!("repeats terms_1d[{first}]"),
+                ));
             }
         }
         for (t, term) in self.terms_2d.iter().enumerate() {
             term.validate(&format!("terms_2d[{t}]"))?;
             if let Some(first) = self.terms_2d[..t].iter().position(|x| x.axes == term.axes) {
-                return Err(ValidationError::new(format!("terms_2d[{t}]"), format!("repeats terms_2d[{first}]")));
+                return Err(ValidationError::new(
+                    format!("terms_2d[{t}]"),
+                    format!("repeats terms_2d[{first}]"),
+                ));
             }
         }
         Ok(())
@@ -189,7 +195,10 @@ fn validate_knots(field: &str, knots: &[f64]) -> Result<(), ValidationError> {
 impl CubicTerm {
     fn validate(&self, field: &str) -> Result<(), ValidationError> {
         if self.axis >= 5 {
-            return Err(ValidationError::new(format!("{field}.axis"), format!("must be below 5, got {}", self.axis)));
+            return Err(ValidationError::new(
+                format!("{field}.axis"),
+                format!("must be below 5, got {}", self.axis),
+            ));
         }
         validate_knots(&format!("{field}.knots"), &self.knots)?;
         let n = self.knots.len();
@@ -212,13 +221,18 @@ impl BicubicTerm {
         if !(u < v && v < 5 && u < 3) {
             return Err(ValidationError::new(
                 format!("{field}.axes"),
-                format!("must be two ascending axis indices below 5, the first in-plane (< 3); got {:?}", self.axes),
+                format!(
+                    "must be two ascending axis indices below 5, the first in-plane (< 3); got {:?}",
+                    self.axes
+                ),
             ));
         }
         validate_knots(&format!("{field}.u_knots"), &self.u_knots)?;
         validate_knots(&format!("{field}.v_knots"), &self.v_knots)?;
         let n = self.u_knots.len() * self.v_knots.len();
-        for (name, values) in [("values", &self.values), ("du", &self.du), ("dv", &self.dv), ("duv", &self.duv)] {
+        for (name, values) in
+            [("values", &self.values), ("du", &self.du), ("dv", &self.dv), ("duv", &self.duv)]
+        {
             check::len(&format!("{field}.{name}"), values.len(), n, "nodes")?;
             check::finite(&format!("{field}.{name}"), values)?;
         }
@@ -236,7 +250,12 @@ mod tests {
             areal_density_kg_m2: 0.3,
             strain_scale: [1.0; 5],
             rest_energy_density_j_m2: 0.0,
-            terms_1d: vec![CubicTerm { axis: 0, knots: vec![-1.0, 0.0, 1.0], values: vec![1.0, 0.0, 1.0], slopes: vec![-2.0, 0.0, 2.0] }],
+            terms_1d: vec![CubicTerm {
+                axis: 0,
+                knots: vec![-1.0, 0.0, 1.0],
+                values: vec![1.0, 0.0, 1.0],
+                slopes: vec![-2.0, 0.0, 2.0],
+            }],
             terms_2d: vec![BicubicTerm {
                 axes: [0, 2],
                 u_knots: vec![-1.0, 1.0],

@@ -135,7 +135,11 @@ fn settings(args: &GridFitArgs) -> FitSettings {
 /// A grid artifact from a file, with its input reference.
 fn load_grid(path: &Path) -> anyhow::Result<(Grid, InputRef)> {
     let loaded = inputs::load(path, None)?;
-    let input = InputRef { kind: "grid".into(), content_hash: loaded.header.content_hash.clone(), path: path.display().to_string() };
+    let input = InputRef {
+        kind: "grid".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: path.display().to_string(),
+    };
     match loaded.artifact {
         AnyArtifact::Grid(grid) => Ok((grid, input)),
         other => anyhow::bail!("{}: holds a '{}', not a grid", path.display(), other.kind()),
@@ -160,7 +164,11 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
     };
     let (grid, input) = load_grid(grid_path)?;
     if !grid.is_complete() {
-        eprintln!("warning: the grid holds {} of its plan's {} samples", grid.samples.len(), grid.expected_samples());
+        eprintln!(
+            "warning: the grid holds {} of its plan's {} samples",
+            grid.samples.len(),
+            grid.expected_samples()
+        );
     }
     let spline = fit_grid(&grid, &settings(&args), args.areal_density)
         .with_context(|| format!("cannot fit {}", grid_path.display()))?;
@@ -174,7 +182,9 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
 /// The fit's relative RMS error on each term of its grid (the acceptance figure).
 fn print_errors(grid: &Grid, spline: &Spline) {
     let material = SplineMaterial::from(spline);
-    println!("relative RMS error of the fit on its grid: of Ψ; of Ψ - f0; of Ψ without 2D compression (A.3.6):");
+    println!(
+        "relative RMS error of the fit on its grid: of Ψ; of Ψ - f0; of Ψ without 2D compression (A.3.6):"
+    );
     for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2) {
         let modelled = e.relative_rms_modelled.map_or("-".to_string(), |r| format!("{:6.2}%", 100.0 * r));
         println!(
@@ -206,7 +216,8 @@ fn export(args: ExportArgs) -> anyhow::Result<Outcome> {
 fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
     let (grid, _) = load_grid(&args.grid)?;
     let spline = load_spline(&args.spline)?;
-    std::fs::create_dir_all(&args.output).with_context(|| format!("cannot create {}", args.output.display()))?;
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("cannot create {}", args.output.display()))?;
     for path in crate::fit_plot::plot_fit(&grid, &spline, &args.output)? {
         println!("wrote {}", path.display());
     }
@@ -225,7 +236,10 @@ fn knot_range(spline: &Spline, axis: usize) -> Option<[f64; 2]> {
 fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
     let (a, b) = (load_spline(&args.first)?, load_spline(&args.second)?);
     let (ma, mb) = (SplineMaterial::from(&a), SplineMaterial::from(&b));
-    println!("1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:", a.name, b.name);
+    println!(
+        "1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:",
+        a.name, b.name
+    );
     println!("  term  range                 RMS first  RMS second  RMS difference  shape correlation");
     for axis in 0..5 {
         let (Some(ra), Some(rb)) = (knot_range(&a, axis), knot_range(&b, axis)) else { continue };

@@ -87,7 +87,8 @@ struct StvkFile {
 pub fn load_material(path: &Path) -> anyhow::Result<ShellMaterial> {
     let text = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     if text.windows(10).any(|w| w == b"\"membrane\"") {
-        let file: StvkFile = serde_json::from_slice(&text).with_context(|| format!("{}: not a Ch. 6 material", path.display()))?;
+        let file: StvkFile = serde_json::from_slice(&text)
+            .with_context(|| format!("{}: not a Ch. 6 material", path.display()))?;
         return Ok(ShellMaterial::stvk(file.areal_density_kg_m2, file.membrane, file.bending));
     }
     let spline = crate::fit::load_spline(path)?;
@@ -175,7 +176,12 @@ fn write_frame<W: Write + Seek>(
     name: &str,
 ) -> Result<(), yarnhom_trace::TraceError> {
     let positions_m = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-    trace.write_frame(&MeshFrame { mesh: name.into(), frame: report.frame, time_s: report.time_s, positions_m })?;
+    trace.write_frame(&MeshFrame {
+        mesh: name.into(),
+        frame: report.frame,
+        time_s: report.time_s,
+        positions_m,
+    })?;
     let values = BTreeMap::from([
         ("elastic_energy_j".to_string(), report.elastic_energy_j),
         ("kinetic_energy_j".to_string(), report.kinetic_energy_j),

@@ -406,13 +406,17 @@ fn rve_sample_shards_merge_into_the_unsharded_grid_and_a_killed_run_resumes() {
 fn fit_writes_a_spline_that_reproduces_its_grid_and_plots_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let grid = dir.path().join("synthetic.grid.yh");
-    let provenance = Provenance { producer: yarnhom_artifacts::Producer { name: "test".into(), version: "0".into() }, inputs: vec![] };
+    let provenance = Provenance {
+        producer: yarnhom_artifacts::Producer { name: "test".into(), version: "0".into() },
+        inputs: vec![],
+    };
     container::write(&grid, &yarnhom_fit::synthetic::synthetic_grid(), &provenance).expect("grid");
     let report = ok(&["fit", "synthetic.grid.yh", "-o", "synthetic.spline.yh"], dir.path());
     assert!(report.contains("sx,kx") && report.contains("relative RMS"), "{report}");
     let inspect = ok(&["inspect", "synthetic.spline.yh"], dir.path());
     assert!(inspect.contains("spline") && inspect.contains("fitted by yarnhom"), "{inspect}");
-    let figures = ok(&["fit", "plot", "synthetic.grid.yh", "synthetic.spline.yh", "-o", "figures"], dir.path());
+    let figures =
+        ok(&["fit", "plot", "synthetic.grid.yh", "synthetic.spline.yh", "-o", "figures"], dir.path());
     assert_eq!(figures.lines().filter(|l| l.ends_with(".svg")).count(), 14, "{figures}");
     fails_with(&["fit", "synthetic.spline.yh", "-o", "x.spline.yh"], dir.path(), "not a grid");
 }
@@ -423,34 +427,78 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
     let published = format!("{}/../../../shared/data/hylc-materials/satin1.json", env!("CARGO_MANIFEST_DIR"));
     ok(&["fit", "import-arcsim", &published, "-o", "satin.spline.yh"], dir.path());
     ok(&["fit", "export-arcsim", "satin.spline.yh", "-o", "satin.json"], dir.path());
-    let (a, b) = (std::fs::read_to_string(&published).expect("published"), std::fs::read_to_string(dir.path().join("satin.json")).expect("ours"));
-    let (a, b): (serde_json::Value, serde_json::Value) = (serde_json::from_str(&a).expect("json"), serde_json::from_str(&b).expect("json"));
+    let (a, b) = (
+        std::fs::read_to_string(&published).expect("published"),
+        std::fs::read_to_string(dir.path().join("satin.json")).expect("ours"),
+    );
+    let (a, b): (serde_json::Value, serde_json::Value) =
+        (serde_json::from_str(&a).expect("json"), serde_json::from_str(&b).expect("json"));
     assert_eq!(a["coeffs"], b["coeffs"], "every coefficient survives import and export");
 
     // Three frames of the drape on a 9 x 9 mesh, streamed to stdout, read back as a trace.
     let out = yarnhom(
-        &["shell", "simulate", "drape", "--material", "satin.spline.yh", "-o", "-", "--frames", "3", "--resolution", "9", "--obj-dir", "obj"],
+        &[
+            "shell",
+            "simulate",
+            "drape",
+            "--material",
+            "satin.spline.yh",
+            "-o",
+            "-",
+            "--frames",
+            "3",
+            "--resolution",
+            "9",
+            "--obj-dir",
+            "obj",
+        ],
         dir.path(),
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let messages: Vec<_> = yarnhom_trace::TraceReader::new(&out.stdout[..]).collect::<Result<_, _>>().expect("a complete trace");
+    let messages: Vec<_> =
+        yarnhom_trace::TraceReader::new(&out.stdout[..]).collect::<Result<_, _>>().expect("a complete trace");
     let count = |f: &dyn Fn(&yarnhom_trace::TraceMessage) -> bool| messages.iter().filter(|m| f(m)).count();
     assert_eq!(count(&|m| matches!(m, yarnhom_trace::TraceMessage::Topology(_))), 1);
     assert_eq!(count(&|m| matches!(m, yarnhom_trace::TraceMessage::Frame(_))), 4);
     assert_eq!(count(&|m| matches!(m, yarnhom_trace::TraceMessage::Scalars(_))), 4);
     assert_eq!(count(&|m| matches!(m, yarnhom_trace::TraceMessage::Solver(_))), 12, "4 steps per frame");
-    let Some(yarnhom_trace::TraceMessage::Frame(last)) = messages.iter().rev().find(|m| matches!(m, yarnhom_trace::TraceMessage::Frame(_))) else {
+    let Some(yarnhom_trace::TraceMessage::Frame(last)) =
+        messages.iter().rev().find(|m| matches!(m, yarnhom_trace::TraceMessage::Frame(_)))
+    else {
         panic!("no frame")
     };
     assert_eq!(last.positions_m.len(), 81);
     assert!(last.positions_m.iter().any(|p| p[2] < -1e-4), "the cloth falls");
     assert_eq!(std::fs::read_dir(dir.path().join("obj")).expect("obj dir").count(), 4);
 
-    fails_with(&["shell", "simulate", "wave", "--material", "satin.spline.yh", "-o", "x.mcap"], dir.path(), "neither a built-in scene");
+    fails_with(
+        &["shell", "simulate", "wave", "--material", "satin.spline.yh", "-o", "x.mcap"],
+        dir.path(),
+        "neither a built-in scene",
+    );
     std::fs::write(dir.path().join("bad.json"), "{\"membrane\": 1}").expect("write");
-    fails_with(&["shell", "simulate", "drape", "--material", "bad.json", "-o", "x.mcap"], dir.path(), "not a Ch. 6 material");
+    fails_with(
+        &["shell", "simulate", "drape", "--material", "bad.json", "-o", "x.mcap"],
+        dir.path(),
+        "not a Ch. 6 material",
+    );
     let scene = ok(&["shell", "scene", "stretch-x", "-o", "scene.json"], dir.path());
     assert!(scene.contains("scene.json"));
-    ok(&["shell", "simulate", "scene.json", "--material", &published, "-o", "s.mcap", "--frames", "1", "--resolution", "7"], dir.path());
+    ok(
+        &[
+            "shell",
+            "simulate",
+            "scene.json",
+            "--material",
+            &published,
+            "-o",
+            "s.mcap",
+            "--frames",
+            "1",
+            "--resolution",
+            "7",
+        ],
+        dir.path(),
+    );
     assert!(dir.path().join("s.mcap").exists());
 }

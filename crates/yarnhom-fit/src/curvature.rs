@@ -45,7 +45,8 @@ pub fn principal_curvatures(ii: [f64; 3]) -> PrincipalCurvatures {
     let ddn = 2.0 * e_b * e_b.transpose();
     let g = n / q;
     let dg = dn / q - n * dq / (q * q);
-    let ddg = ddn / q - (dn * dq.transpose() + dq * dn.transpose()) / (q * q) + 2.0 * n * dq * dq.transpose() / (q * q * q)
+    let ddg = ddn / q - (dn * dq.transpose() + dq * dn.transpose()) / (q * q)
+        + 2.0 * n * dq * dq.transpose() / (q * q * q)
         - n * ddq / (q * q);
 
     PrincipalCurvatures {
@@ -110,7 +111,10 @@ mod tests {
                     assert!((p.gradient[(c, j)] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "{ii:?} d{c}/d{j}");
                     for i in 0..3 {
                         let fd2 = (pp.gradient[(c, i)] - pm.gradient[(c, i)]) / (2.0 * h);
-                        assert!((p.hessian[c][(i, j)] - fd2).abs() < 1e-5 * (1.0 + fd2.abs()), "{ii:?} d2{c}/d{i}d{j}");
+                        assert!(
+                            (p.hessian[c][(i, j)] - fd2).abs() < 1e-5 * (1.0 + fd2.abs()),
+                            "{ii:?} d2{c}/d{i}d{j}"
+                        );
                     }
                 }
             }

@@ -5,11 +5,13 @@
 //! (A.37, A.38).
 
 use yarnhom_artifacts::grid::strain_values;
-use yarnhom_artifacts::{BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin};
+use yarnhom_artifacts::{
+    BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
+};
 
 use crate::march::{
-    bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d, quasiconvexify_1d,
-    zero_knot_index,
+    bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d,
+    quasiconvexify_1d, zero_knot_index,
 };
 use crate::mls::{HermiteGrid, SmoothedEnergy1d, SmoothedEnergy2d};
 use crate::monotone_bicubic::make_monotone_bicubic;
@@ -61,9 +63,9 @@ pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -
     let mut terms_2d = Vec::new();
     for (t, term) in grid.terms.iter().enumerate() {
         let data = TermData::gather(grid, t, &scale)?;
-        match term.axes.as_slice() {
-            &[axis] => terms_1d.push(fit_1d(axis as usize, &data, settings)?),
-            &[u, v] => terms_2d.push(fit_2d([u as usize, v as usize], &data, settings)?),
+        match *term.axes.as_slice() {
+            [axis] => terms_1d.push(fit_1d(axis as usize, &data, settings)?),
+            [u, v] => terms_2d.push(fit_2d([u as usize, v as usize], &data, settings)?),
             _ => {}
         }
     }
@@ -173,7 +175,8 @@ pub fn control_points(range: [f64; 2], span: f64, per_side: usize) -> Vec<f64> {
 
 /// Alg. 4: one 1D term.
 fn fit_1d(axis: usize, data: &TermData, settings: &FitSettings) -> Result<CubicTerm, FitError> {
-    let mut smoothed = SmoothedEnergy1d::new(&data.strains[0], &data.energies, data.radius.max(settings.mls_radius));
+    let mut smoothed =
+        SmoothedEnergy1d::new(&data.strains[0], &data.energies, data.radius.max(settings.mls_radius));
     if axis == SHEAR && settings.symmetrize_shear {
         smoothed = smoothed.symmetric();
     }
@@ -294,7 +297,8 @@ pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec
             };
             let all = pairs(&|_| true);
             let uncompressed = term.axes.len() == 1 || term.axes.as_slice() == POISSON_PAIR.map(|a| a as u8);
-            let modelled = pairs(&|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0));
+            let modelled =
+                pairs(&|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0));
             TermError {
                 term: term.name(),
                 samples: all.len(),
@@ -308,7 +312,9 @@ pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec
 
 /// RMS of (fit - data) over RMS of (data - offset), for `(fit, data)` pairs.
 fn relative_rms(pairs: &[(f64, f64)], offset: f64) -> f64 {
-    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt();
+    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
+        (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt()
+    };
     rms(&|(fit, data)| fit - data) / rms(&|(_, data)| data - offset)
 }
 

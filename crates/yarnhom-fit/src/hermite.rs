@@ -54,7 +54,12 @@ fn locate(knots: &[f64], x: f64) -> (usize, Basis) {
         Basis {
             w: [
                 [2.0 * s3 - 3.0 * s2 + 1.0, -2.0 * s3 + 3.0 * s2, h * (s3 - 2.0 * s2 + s), h * (s3 - s2)],
-                [(6.0 * s2 - 6.0 * s) / h, (-6.0 * s2 + 6.0 * s) / h, 3.0 * s2 - 4.0 * s + 1.0, 3.0 * s2 - 2.0 * s],
+                [
+                    (6.0 * s2 - 6.0 * s) / h,
+                    (-6.0 * s2 + 6.0 * s) / h,
+                    3.0 * s2 - 4.0 * s + 1.0,
+                    3.0 * s2 - 2.0 * s,
+                ],
                 [
                     (12.0 * s - 6.0) / (h * h),
                     (-12.0 * s + 6.0) / (h * h),
@@ -155,14 +160,25 @@ mod tests {
     use super::*;
 
     fn cubic() -> Cubic {
-        Cubic { knots: vec![-1.0, -0.2, 0.5, 2.0], values: vec![1.0, 0.1, 0.3, 2.0], slopes: vec![-3.0, 0.2, 0.5, 1.5] }
+        Cubic {
+            knots: vec![-1.0, -0.2, 0.5, 2.0],
+            values: vec![1.0, 0.1, 0.3, 2.0],
+            slopes: vec![-3.0, 0.2, 0.5, 1.5],
+        }
     }
 
     fn bicubic() -> Bicubic {
         let (u_knots, v_knots) = (vec![-1.0, 0.0, 0.7], vec![-0.5, 0.0, 0.4, 1.0]);
         let n = u_knots.len() * v_knots.len();
         let wave = |k: usize, a: f64| (0..n).map(|i| ((i * 7 + k) as f64 * a).sin()).collect::<Vec<_>>();
-        Bicubic { u_knots, v_knots, values: wave(0, 0.9), du: wave(1, 1.3), dv: wave(2, 0.4), duv: wave(3, 2.1) }
+        Bicubic {
+            u_knots,
+            v_knots,
+            values: wave(0, 0.9),
+            du: wave(1, 1.3),
+            dv: wave(2, 0.4),
+            duv: wave(3, 2.1),
+        }
     }
 
     #[test]
@@ -209,12 +225,16 @@ mod tests {
             let jet = g.jet(u, v);
             let (up, um, vp, vm) = (g.jet(u + h, v), g.jet(u - h, v), g.jet(u, v + h), g.jet(u, v - h));
             let fd = [(up.value - um.value) / (2.0 * h), (vp.value - vm.value) / (2.0 * h)];
-            let fd2 = [(up.d1[0] - um.d1[0]) / (2.0 * h), (vp.d1[0] - vm.d1[0]) / (2.0 * h), (vp.d1[1] - vm.d1[1]) / (2.0 * h)];
-            for k in 0..2 {
-                assert!((jet.d1[k] - fd[k]).abs() < 1e-6, "({u}, {v}) d1[{k}]");
+            let fd2 = [
+                (up.d1[0] - um.d1[0]) / (2.0 * h),
+                (vp.d1[0] - vm.d1[0]) / (2.0 * h),
+                (vp.d1[1] - vm.d1[1]) / (2.0 * h),
+            ];
+            for (k, (d, f)) in jet.d1.iter().zip(fd).enumerate() {
+                assert!((d - f).abs() < 1e-6, "({u}, {v}) d1[{k}]");
             }
-            for k in 0..3 {
-                assert!((jet.d2[k] - fd2[k]).abs() < 1e-5, "({u}, {v}) d2[{k}]");
+            for (k, (d, f)) in jet.d2.iter().zip(fd2).enumerate() {
+                assert!((d - f).abs() < 1e-5, "({u}, {v}) d2[{k}]");
             }
         }
     }
@@ -239,7 +259,10 @@ mod tests {
         for v in [-0.3, 0.1, 0.8] {
             for u in [-1.0, 0.7] {
                 let (a, b) = (g.jet(u - 1e-9, v), g.jet(u + 1e-9, v));
-                assert!((a.value - b.value).abs() < 1e-8 && (a.d1[0] - b.d1[0]).abs() < 1e-6, "u = {u}, v = {v}");
+                assert!(
+                    (a.value - b.value).abs() < 1e-8 && (a.d1[0] - b.d1[0]).abs() < 1e-6,
+                    "u = {u}, v = {v}"
+                );
             }
         }
     }

@@ -69,7 +69,11 @@ impl From<&Spline> for SplineMaterial {
                 .map(|t| Term1d {
                     axis: t.axis as usize,
                     scale: scale(t.axis),
-                    spline: Cubic { knots: t.knots.clone(), values: t.values.clone(), slopes: t.slopes.clone() },
+                    spline: Cubic {
+                        knots: t.knots.clone(),
+                        values: t.values.clone(),
+                        slopes: t.slopes.clone(),
+                    },
                 })
                 .collect(),
             terms_2d: spline
@@ -149,11 +153,11 @@ impl SplineMaterial {
         dz.fixed_view_mut::<3, 3>(0, 0).copy_from(&ds);
         dz.fixed_view_mut::<3, 3>(3, 3).copy_from(&pc.gradient);
         let mut hessian = dz.transpose() * inner.hessian * dz;
-        for k in 0..3 {
+        for (k, (d2s, d2p)) in dds.iter().zip(&pc.hessian).enumerate() {
             let mut block = hessian.fixed_view_mut::<3, 3>(0, 0);
-            block += inner.gradient[k] * dds[k];
+            block += inner.gradient[k] * d2s;
             let mut block = hessian.fixed_view_mut::<3, 3>(3, 3);
-            block += inner.gradient[3 + k] * pc.hessian[k];
+            block += inner.gradient[3 + k] * d2p;
         }
         EnergyJet { value: inner.value, gradient: dz.transpose() * inner.gradient, hessian }
     }
@@ -235,18 +239,30 @@ pub fn planar_strains(first: [f64; 3]) -> (Vector3<f64>, Matrix3<f64>, [Matrix3<
     let (ra, rc) = (a.sqrt(), c.sqrt());
     let sa = b / (ra * rc);
     let ds = Matrix3::new(
-        0.5 / ra, 0.0, 0.0, //
-        -0.5 * sa / a, 1.0 / (ra * rc), -0.5 * sa / c, //
-        0.0, 0.0, 0.5 / rc,
+        0.5 / ra,
+        0.0,
+        0.0, //
+        -0.5 * sa / a,
+        1.0 / (ra * rc),
+        -0.5 * sa / c, //
+        0.0,
+        0.0,
+        0.5 / rc,
     );
     let dd_sx = Matrix3::new(-0.25 / (a * ra), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
     let dd_sy = Matrix3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -0.25 / (c * rc));
     // sa = b a^{-1/2} c^{-1/2}
     let (ab, ac, bc) = (-0.5 / (a * ra * rc), 0.25 * sa / (a * c), -0.5 / (ra * c * rc));
     let dd_sa = Matrix3::new(
-        0.75 * sa / (a * a), ab, ac, //
-        ab, 0.0, bc, //
-        ac, bc, 0.75 * sa / (c * c),
+        0.75 * sa / (a * a),
+        ab,
+        ac, //
+        ab,
+        0.0,
+        bc, //
+        ac,
+        bc,
+        0.75 * sa / (c * c),
     );
     (Vector3::new(ra - 1.0, sa, rc - 1.0), ds, [dd_sx, dd_sa, dd_sy])
 }
@@ -274,7 +290,10 @@ mod tests {
             for k in 0..3 {
                 assert!((ds[(k, j)] - (sp[k] - sm[k]) / (2.0 * h)).abs() < 1e-8, "ds[{k}][{j}]");
                 for i in 0..3 {
-                    assert!((dds[k][(i, j)] - (dp[(k, i)] - dm[(k, i)]) / (2.0 * h)).abs() < 1e-7, "dds[{k}][{i}{j}]");
+                    assert!(
+                        (dds[k][(i, j)] - (dp[(k, i)] - dm[(k, i)]) / (2.0 * h)).abs() < 1e-7,
+                        "dds[{k}][{i}{j}]"
+                    );
                 }
             }
         }
@@ -299,11 +318,19 @@ mod tests {
                 m[j] -= h;
                 let (jp, jm) = (at(p), at(m));
                 let fd = (jp.value - jm.value) / (2.0 * h);
-                assert!((jet.gradient[j] - fd).abs() < 1e-5 * (1.0 + fd.abs()), "{x:?}: dΨ/d{j} {} vs {fd}", jet.gradient[j]);
+                assert!(
+                    (jet.gradient[j] - fd).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "{x:?}: dΨ/d{j} {} vs {fd}",
+                    jet.gradient[j]
+                );
                 for i in 0..6 {
                     let fd2 = (jp.gradient[i] - jm.gradient[i]) / (2.0 * h);
                     let scale = 1.0 + jet.hessian.column(j).amax();
-                    assert!((jet.hessian[(i, j)] - fd2).abs() < 1e-4 * scale, "{x:?}: d²Ψ/d{i}d{j} {} vs {fd2}", jet.hessian[(i, j)]);
+                    assert!(
+                        (jet.hessian[(i, j)] - fd2).abs() < 1e-4 * scale,
+                        "{x:?}: d²Ψ/d{i}d{j} {} vs {fd2}",
+                        jet.hessian[(i, j)]
+                    );
                 }
             }
         }
@@ -318,7 +345,12 @@ mod tests {
             let rest = material.jet([1.0, 0.0, 1.0], [0.0; 3]).gradient;
             let stretched = material.jet([1.1 * 1.1, 0.0, 1.1 * 1.1], [0.0; 3]).gradient;
             for k in [0, 2] {
-                assert!(rest[k].abs() < 0.05 * stretched[k].abs(), "{name}: dΨ/dI[{k}] {} at rest vs {} at 10%", rest[k], stretched[k]);
+                assert!(
+                    rest[k].abs() < 0.05 * stretched[k].abs(),
+                    "{name}: dΨ/dI[{k}] {} at rest vs {} at 10%",
+                    rest[k],
+                    stretched[k]
+                );
             }
         }
     }

@@ -112,4 +112,3 @@ pub fn synthetic_grid_of(energy: &dyn Fn([f64; 5]) -> f64) -> Grid {
 pub fn synthetic_grid() -> Grid {
     synthetic_grid_of(&energy)
 }
-

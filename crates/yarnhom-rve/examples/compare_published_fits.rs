@@ -8,8 +8,8 @@
 //! from the published geometry).
 
 use yarnhom_artifacts::arcsim::read_spline;
-use yarnhom_fit::SplineMaterial;
 use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
+use yarnhom_fit::SplineMaterial;
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::solve_at;
 use yarnhom_rve::{RelaxOptions, RveModel, SolveOptions, relax};
@@ -40,7 +40,8 @@ fn main() {
         let text = std::fs::read_to_string(format!("{DATA}/hylc-patterns/{name}.pyp")).expect("pattern");
         let pattern = parse_pyp(&text, name, None).expect("imports");
         let path = format!("{DATA}/hylc-materials/{name}1.json");
-        let fit = SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published fit imports"));
+        let fit =
+            SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published fit imports"));
         let yarn = YarnModel::table_4_1(name).expect("row");
         let model = RveModel::new(&pattern_for(&mode, pattern, &yarn), &yarn).expect("tile");
         let zero: MacroStrain = "sx=0".parse().expect("strain");

@@ -2,8 +2,8 @@
 //! About 7 s in all (the rib tile's solves take 3 s each).
 
 use yarnhom_artifacts::arcsim::read_spline;
-use yarnhom_fit::SplineMaterial;
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
+use yarnhom_fit::SplineMaterial;
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::solve_at;
 use yarnhom_rve::{RveModel, SolveOptions};

@@ -55,7 +55,10 @@ pub fn import(doc: &Value, name: &str) -> Result<Scene, SceneError> {
     Ok(scene)
 }
 
-fn motions(doc: &Value, name: &str) -> Result<Vec<Vec<(f64, [f64; 3])>>, SceneError> {
+/// Keyframes `(time_s, translation_m)` of one motion.
+type Keyframes = Vec<(f64, [f64; 3])>;
+
+fn motions(doc: &Value, name: &str) -> Result<Vec<Keyframes>, SceneError> {
     let Some(list) = doc.get("motions").and_then(Value::as_array) else { return Ok(Vec::new()) };
     list.iter()
         .map(|motion| {
@@ -78,7 +81,10 @@ fn handles(doc: &Value, name: &str) -> Result<Vec<HandleSpec>, SceneError> {
     let mut out = Vec::new();
     for h in doc.get("handlebars").and_then(Value::as_array).into_iter().flatten() {
         out.push(HandleSpec::Bar {
-            side: h.get("side").and_then(Value::as_u64).ok_or_else(|| invalid(name, "handlebar without side"))? as u8,
+            side: h
+                .get("side")
+                .and_then(Value::as_u64)
+                .ok_or_else(|| invalid(name, "handlebar without side"))? as u8,
             length: number(h, "lengthp").unwrap_or(1.0),
             width: number(h, "widthp").unwrap_or(0.05),
             inset: number(h, "insetp").unwrap_or(0.0),
@@ -122,12 +128,20 @@ mod tests {
     #[test]
     fn the_builtins_equal_the_published_stockinette_scenes() {
         // Same handles, motions, obstacles, times and contact thickness as the files.
-        for (file, builtin) in [("stock_stretchX.json", "stretch-x"), ("stock_stretchY.json", "stretch-y"), ("stock_drapeX.json", "drape")] {
+        for (file, builtin) in [
+            ("stock_stretchX.json", "stretch-x"),
+            ("stock_stretchY.json", "stretch-y"),
+            ("stock_drapeX.json", "drape"),
+        ] {
             let (a, b) = (published(file), Scene::builtin(builtin).expect("builtin"));
             assert_eq!(a.handles, b.handles, "{file}");
             assert_eq!(a.motions, b.motions, "{file}");
             assert_eq!(a.obstacles, b.obstacles, "{file}");
-            assert_eq!((a.end_time_s, a.frame_time_s, a.size_m), (b.end_time_s, b.frame_time_s, b.size_m), "{file}");
+            assert_eq!(
+                (a.end_time_s, a.frame_time_s, a.size_m),
+                (b.end_time_s, b.frame_time_s, b.size_m),
+                "{file}"
+            );
             assert_eq!(a.contact.thickness_m, b.contact.thickness_m, "{file}");
         }
     }

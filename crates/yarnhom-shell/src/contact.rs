@@ -112,13 +112,21 @@ pub struct ObstacleContact {
 }
 
 /// Obstacle contacts of all vertices within the thickness.
-pub fn obstacle_contacts(obstacles: &[Obstacle], settings: &ContactSettings, x: &[Vector3<f64>]) -> Vec<ObstacleContact> {
+pub fn obstacle_contacts(
+    obstacles: &[Obstacle],
+    settings: &ContactSettings,
+    x: &[Vector3<f64>],
+) -> Vec<ObstacleContact> {
     let mut contacts = Vec::new();
     for (vertex, p) in x.iter().enumerate() {
         for o in obstacles {
             let (d, normal) = o.distance(p);
             if d < settings.thickness_m {
-                contacts.push(ObstacleContact { vertex, force_n: settings.stiffness_n_m * (settings.thickness_m - d), normal });
+                contacts.push(ObstacleContact {
+                    vertex,
+                    force_n: settings.stiffness_n_m * (settings.thickness_m - d),
+                    normal,
+                });
             }
         }
     }
@@ -127,7 +135,10 @@ pub fn obstacle_contacts(obstacles: &[Obstacle], settings: &ContactSettings, x: 
 
 /// Obstacle penalty energy (J).
 pub fn obstacle_energy(obstacles: &[Obstacle], settings: &ContactSettings, x: &[Vector3<f64>]) -> f64 {
-    obstacle_contacts(obstacles, settings, x).iter().map(|c| 0.5 * c.force_n * c.force_n / settings.stiffness_n_m).sum()
+    obstacle_contacts(obstacles, settings, x)
+        .iter()
+        .map(|c| 0.5 * c.force_n * c.force_n / settings.stiffness_n_m)
+        .sum()
 }
 
 /// Pairs of vertices that may repel: far enough apart in the material.
@@ -170,12 +181,15 @@ impl SelfCollision {
         let mut pairs = Vec::new();
         for (i, p) in x.iter().enumerate() {
             let [a, b, c] = key(p);
-            for (da, db, dc) in (-1..=1).flat_map(|a| (-1..=1).flat_map(move |b| (-1..=1).map(move |c| (a, b, c)))) {
+            for (da, db, dc) in
+                (-1..=1).flat_map(|a| (-1..=1).flat_map(move |b| (-1..=1).map(move |c| (a, b, c))))
+            {
                 let Some(bucket) = grid.get(&[a + da, b + db, c + dc]) else { continue };
                 for &j in bucket.iter().filter(|&&j| j > i) {
                     let r = x[j] - p;
                     let distance = r.norm();
-                    let apart = (self.material[j] - self.material[i]).norm() >= SELF_EXCLUSION * self.thickness;
+                    let apart =
+                        (self.material[j] - self.material[i]).norm() >= SELF_EXCLUSION * self.thickness;
                     if distance < self.thickness && distance > 0.0 && apart {
                         pairs.push(RepulsionPair { vertices: [i, j], distance, direction: r / distance });
                     }
@@ -192,7 +206,12 @@ impl SelfCollision {
     }
 
     /// Gradient of the repulsion energy, and the vertex-diagonal Hessian blocks.
-    pub fn forces(&self, pairs: &[RepulsionPair], gradient: &mut [f64], blocks: &mut Vec<(usize, Matrix3<f64>)>) {
+    pub fn forces(
+        &self,
+        pairs: &[RepulsionPair],
+        gradient: &mut [f64],
+        blocks: &mut Vec<(usize, Matrix3<f64>)>,
+    ) {
         for p in pairs {
             let magnitude = self.stiffness * (self.thickness - p.distance);
             let block = self.stiffness * p.direction * p.direction.transpose();
@@ -234,9 +253,17 @@ mod tests {
             self_thickness_m: 0.01,
             self_stiffness_n_m: 100.0,
         };
-        let material = vec![nalgebra::Vector2::new(0.0, 0.0), nalgebra::Vector2::new(1.0, 0.0), nalgebra::Vector2::new(0.001, 0.0)];
+        let material = vec![
+            nalgebra::Vector2::new(0.0, 0.0),
+            nalgebra::Vector2::new(1.0, 0.0),
+            nalgebra::Vector2::new(0.001, 0.0),
+        ];
         let self_collision = SelfCollision::new(&settings, &material).expect("enabled");
-        let x = vec![Vector3::new(0.0, 0.0, 0.0), Vector3::new(0.004, 0.003, 0.001), Vector3::new(0.001, 0.0, 0.0)];
+        let x = vec![
+            Vector3::new(0.0, 0.0, 0.0),
+            Vector3::new(0.004, 0.003, 0.001),
+            Vector3::new(0.001, 0.0, 0.0),
+        ];
         let pairs = self_collision.pairs(&x);
         assert_eq!(pairs.len(), 2, "vertex 2 is a material neighbour of 0 and does not repel it");
         let mut gradient = vec![0.0; 9];
@@ -246,7 +273,9 @@ mod tests {
             let (mut p, mut m) = (x.clone(), x.clone());
             p[dof / 3][dof % 3] += h;
             m[dof / 3][dof % 3] -= h;
-            let fd = (self_collision.energy(&self_collision.pairs(&p)) - self_collision.energy(&self_collision.pairs(&m))) / (2.0 * h);
+            let fd = (self_collision.energy(&self_collision.pairs(&p))
+                - self_collision.energy(&self_collision.pairs(&m)))
+                / (2.0 * h);
             assert!((gradient[dof] - fd).abs() < 1e-6, "dof {dof}: {} vs {fd}", gradient[dof]);
         }
     }

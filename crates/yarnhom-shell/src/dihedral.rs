@@ -73,11 +73,7 @@ pub fn signed_dihedral_angle_with_derivatives(hinge: &[Vec3; 4]) -> DihedralDeri
             add_symmetric_block(&mut hessian, s, t, &hinge.angle_hessian_block(s, t));
         }
     }
-    DihedralDerivatives {
-        angle: hinge.angle(),
-        gradient,
-        hessian,
-    }
+    DihedralDerivatives { angle: hinge.angle(), gradient, hessian }
 }
 
 /// Adds the 3×3 `block` at vertex slots `(s, t)` of a Hessian and, for `s ≠ t`, its transpose
@@ -108,18 +104,11 @@ pub(crate) struct Hinge {
 impl Hinge {
     pub fn new(hinge: &[Vec3; 4]) -> Self {
         let [p0, p1, a, b] = hinge;
-        Self {
-            wing_a: Wing::new(p0, p1, a),
-            wing_b: Wing::new(p1, p0, b),
-        }
+        Self { wing_a: Wing::new(p0, p1, a), wing_b: Wing::new(p1, p0, b) }
     }
 
     pub fn angle(&self) -> f64 {
-        angle_between_normals(
-            &self.wing_a.normal,
-            &self.wing_b.normal,
-            &self.wing_a.edge_dir,
-        )
+        angle_between_normals(&self.wing_a.normal, &self.wing_b.normal, &self.wing_a.edge_dir)
     }
 
     /// `∇θ` per hinge slot `[p0, p1, a, b]`.
@@ -230,8 +219,8 @@ impl Wing {
 mod tests {
     use super::*;
     use crate::test_support::{
-        XorShift, apex_across, assert_all_close, assert_close, fd_gradient, fd_jacobian,
-        random_hinge, random_triangle,
+        XorShift, apex_across, assert_all_close, assert_close, fd_gradient, fd_jacobian, random_hinge,
+        random_triangle,
     };
 
     fn hinge_from(q: &SVector<f64, 12>) -> [Vec3; 4] {
@@ -254,11 +243,7 @@ mod tests {
         };
         assert!(signed_dihedral_angle(&hinge(0.3)) > 0.0);
         assert!(signed_dihedral_angle(&hinge(-0.3)) < 0.0);
-        assert_close(
-            signed_dihedral_angle(&hinge(1.0)),
-            std::f64::consts::FRAC_PI_4,
-            1e-14,
-        );
+        assert_close(signed_dihedral_angle(&hinge(1.0)), std::f64::consts::FRAC_PI_4, 1e-14);
     }
 
     #[test]
@@ -270,11 +255,7 @@ mod tests {
             let b = apex_across(&mut rng, &p0, &p1, &a, fold);
             let hinge = [p0, p1, a, b];
             assert_close(signed_dihedral_angle(&hinge), fold, 1e-12);
-            assert_close(
-                signed_dihedral_angle_with_derivatives(&hinge).angle,
-                fold,
-                1e-12,
-            );
+            assert_close(signed_dihedral_angle_with_derivatives(&hinge).angle, fold, 1e-12);
         }
     }
 
@@ -288,10 +269,8 @@ mod tests {
                 let d = signed_dihedral_angle_with_derivatives(&hinge);
                 let fd = fd_gradient(|q| signed_dihedral_angle(&hinge_from(q)), &q);
                 assert_all_close(&d.gradient, &fd, 1e-6);
-                let fd_hessian = fd_jacobian(
-                    |q| signed_dihedral_angle_with_derivatives(&hinge_from(q)).gradient,
-                    &q,
-                );
+                let fd_hessian =
+                    fd_jacobian(|q| signed_dihedral_angle_with_derivatives(&hinge_from(q)).gradient, &q);
                 assert_all_close(&d.hessian, &fd_hessian, 1e-6);
                 assert_eq!(d.hessian, d.hessian.transpose());
             }

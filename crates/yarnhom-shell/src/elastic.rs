@@ -101,7 +101,8 @@ pub type Element<const N: usize> = (f64, SVector<f64, N>, Option<SMatrix<f64, N,
 impl ElasticModel {
     /// The model of `mesh` made of `material`, rest state flat at the material coordinates.
     pub fn new(mesh: ShellMesh, material: ShellMaterial) -> Self {
-        let rest = mesh.triangles.iter().map(|t| RestTriangle::new(&t.map(|v| mesh.material[v as usize]))).collect();
+        let rest =
+            mesh.triangles.iter().map(|t| RestTriangle::new(&t.map(|v| mesh.material[v as usize]))).collect();
         let hinges = match material.hinge_bending {
             Some(k) => mesh
                 .hinges
@@ -240,7 +241,11 @@ mod tests {
             p[dof / 3][dof % 3] += h;
             m[dof / 3][dof % 3] -= h;
             let fd = (model.energy(&p) - model.energy(&m)) / (2.0 * h);
-            assert!((a.gradient[dof] - fd).abs() < 1e-6 * (1.0 + fd.abs()), "dof {dof}: {} vs {fd}", a.gradient[dof]);
+            assert!(
+                (a.gradient[dof] - fd).abs() < 1e-6 * (1.0 + fd.abs()),
+                "dof {dof}: {} vs {fd}",
+                a.gradient[dof]
+            );
         }
     }
 
@@ -279,9 +284,17 @@ mod tests {
         let x: Vec<_> = mesh
             .material
             .iter()
-            .map(|m| Vector3::new(1.1 * m.x + 0.05 * m.y, 0.95 * m.y, 15.0 * m.x * m.x - 10.0 * m.y * m.y + 5.0 * m.x * m.y))
+            .map(|m| {
+                Vector3::new(
+                    1.1 * m.x + 0.05 * m.y,
+                    0.95 * m.y,
+                    15.0 * m.x * m.x - 10.0 * m.y * m.y + 5.0 * m.x * m.y,
+                )
+            })
             .collect();
-        let t = (0..mesh.triangles.len()).find(|&t| mesh.neighbours[t].iter().all(Option::is_some)).expect("interior");
+        let t = (0..mesh.triangles.len())
+            .find(|&t| mesh.neighbours[t].iter().all(Option::is_some))
+            .expect("interior");
         let vertices = model.stencil_vertices(t).map(|v| v.expect("interior") as usize);
         let (_, gradient, hessian) = model.triangle_element_exact(t, &x, true);
         let hessian = hessian.expect("asked for");
@@ -295,10 +308,19 @@ mod tests {
                 let (em, gm, _) = model.triangle_element_exact(t, &m, false);
                 let i = 3 * a + k;
                 let fd = (ep - em) / (2.0 * h);
-                assert!((gradient[i] - fd).abs() < 1e-6 * gradient.amax(), "dE/dq[{i}]: {} vs {fd}", gradient[i]);
+                assert!(
+                    (gradient[i] - fd).abs() < 1e-6 * gradient.amax(),
+                    "dE/dq[{i}]: {} vs {fd}",
+                    gradient[i]
+                );
                 let fd2 = (gp - gm) / (2.0 * h);
                 for j in 0..18 {
-                    assert!((hessian[(j, i)] - fd2[j]).abs() < 1e-5 * hessian.amax(), "H[{j}][{i}]: {} vs {}", hessian[(j, i)], fd2[j]);
+                    assert!(
+                        (hessian[(j, i)] - fd2[j]).abs() < 1e-5 * hessian.amax(),
+                        "H[{j}][{i}]: {} vs {}",
+                        hessian[(j, i)],
+                        fd2[j]
+                    );
                 }
             }
         }

@@ -43,15 +43,9 @@ impl RestTriangle {
     pub fn new(material: &[Vector2<f64>; 3]) -> Self {
         let edges = Matrix2::from_columns(&[material[1] - material[0], material[2] - material[0]]);
         let rest_area = 0.5 * edges.determinant();
-        assert!(
-            rest_area > 0.0,
-            "rest triangle must be counter-clockwise and non-degenerate"
-        );
+        assert!(rest_area > 0.0, "rest triangle must be counter-clockwise and non-degenerate");
         let rest_inverse = edges.try_inverse().expect("non-degenerate rest triangle");
-        Self {
-            rest_inverse,
-            rest_area,
-        }
+        Self { rest_inverse, rest_area }
     }
 
     /// `w_j = ∇_X λ_j`, the material gradients of the barycentric coordinates.
@@ -190,14 +184,10 @@ fn add_first_form(out: &mut FormsWithDerivatives, w: &[Vector2<f64>; 3], x: &[Ve
         out.first[row] = f[a].dot(&f[b]);
         for j in 0..3 {
             let gradient = f[b] * w[j][a] + f[a] * w[j][b];
-            out.gradient
-                .fixed_view_mut::<1, 3>(row, 3 * j)
-                .copy_from(&gradient.transpose());
+            out.gradient.fixed_view_mut::<1, 3>(row, 3 * j).copy_from(&gradient.transpose());
             for k in 0..3 {
                 let coefficient = w[j][a] * w[k][b] + w[j][b] * w[k][a];
-                out.hessian[row]
-                    .fixed_view_mut::<3, 3>(3 * j, 3 * k)
-                    .fill_diagonal(coefficient);
+                out.hessian[row].fixed_view_mut::<3, 3>(3 * j, 3 * k).fill_diagonal(coefficient);
             }
         }
     }
@@ -206,24 +196,13 @@ fn add_first_form(out: &mut FormsWithDerivatives, w: &[Vector2<f64>; 3], x: &[Ve
 /// Adds edge `i`'s term `c_i w_i ⊗ w_i` of (4.7), `c_i = θ_i h_i`, with its derivatives:
 /// `∇c = h ∇θ + θ ∇h`, `∇²c = h ∇²θ + θ ∇²h + ∇θ ⊗ ∇h + ∇h ⊗ ∇θ` over the hinge
 /// `[x_{i+1}, x_{i+2}, x_i, n_i]` (`h` = altitude of `x_i`, independent of `n_i`).
-fn add_edge_term(
-    out: &mut FormsWithDerivatives,
-    w_i: &Vector2<f64>,
-    x: &[Vec3; 3],
-    i: usize,
-    far: &Vec3,
-) {
+fn add_edge_term(out: &mut FormsWithDerivatives, w_i: &Vector2<f64>, x: &[Vec3; 3], i: usize, far: &Vec3) {
     let [p0, p1, apex] = hinge_edge(x, i);
     let hinge = Hinge::new(&[p0, p1, apex, *far]);
     let (angle, altitude) = (hinge.angle(), hinge.wing_a.altitude);
     let angle_gradient = hinge.angle_gradient();
-    let altitude_gradient = [0, 1, 2, 3].map(|s| {
-        if s < 3 {
-            hinge.wing_a.altitude_gradient(s)
-        } else {
-            Vec3::zeros()
-        }
-    });
+    let altitude_gradient =
+        [0, 1, 2, 3].map(|s| if s < 3 { hinge.wing_a.altitude_gradient(s) } else { Vec3::zeros() });
     let factors = outer_entries(w_i);
     let slots = hinge_slots(i);
     for s in 0..4 {
@@ -236,12 +215,7 @@ fn add_edge_term(
                 block += hinge.wing_a.altitude_hessian_block(s, t) * angle;
             }
             for (k, &factor) in factors.iter().enumerate() {
-                add_symmetric_block(
-                    &mut out.hessian[3 + k],
-                    slots[s],
-                    slots[t],
-                    &(block * factor),
-                );
+                add_symmetric_block(&mut out.hessian[3 + k], slots[s], slots[t], &(block * factor));
             }
         }
         for (k, &factor) in factors.iter().enumerate() {
@@ -258,8 +232,8 @@ fn add_edge_term(
 mod tests {
     use super::*;
     use crate::test_support::{
-        GridMesh, XorShift, apex_across, assert_all_close, assert_close, fd_jacobian,
-        random_triangle, time_per_call,
+        GridMesh, XorShift, apex_across, assert_all_close, assert_close, fd_jacobian, random_triangle,
+        time_per_call,
     };
     use nalgebra::{Matrix3, Rotation3, SVector, Unit};
 
@@ -297,9 +271,7 @@ mod tests {
             let [a, b, c] = random_triangle(rng).map(|v| Vector2::new(v.x, v.y));
             let signed = (b - a).perp(&(c - a));
             let material = if signed > 0.0 { [a, b, c] } else { [a, c, b] };
-            let longest = (0..3)
-                .map(|i| (material[(i + 1) % 3] - material[i]).norm())
-                .fold(0.0, f64::max);
+            let longest = (0..3).map(|i| (material[(i + 1) % 3] - material[i]).norm()).fold(0.0, f64::max);
             if signed.abs() >= 0.2 * longest * longest {
                 return RestTriangle::new(&material);
             }
@@ -316,10 +288,7 @@ mod tests {
             let far = apex_across(rng, &p0, &p1, &apex, angle);
             (mask >> i & 1 == 1).then_some(far)
         });
-        Stencil {
-            triangle,
-            neighbours,
-        }
+        Stencil { triangle, neighbours }
     }
 
     fn random_stencil(rng: &mut XorShift, mask: usize) -> Stencil {
@@ -390,19 +359,9 @@ mod tests {
         let stencil = random_stencil(&mut rng, 0b010);
         let d = forms_with_derivatives(&rest, &stencil);
         for slot in [3, 5] {
-            assert!(
-                d.gradient
-                    .fixed_columns::<3>(3 * slot)
-                    .iter()
-                    .all(|&g| g == 0.0)
-            );
+            assert!(d.gradient.fixed_columns::<3>(3 * slot).iter().all(|&g| g == 0.0));
             for hessian in &d.hessian {
-                assert!(
-                    hessian
-                        .fixed_columns::<3>(3 * slot)
-                        .iter()
-                        .all(|&h| h == 0.0)
-                );
+                assert!(hessian.fixed_columns::<3>(3 * slot).iter().all(|&h| h == 0.0));
             }
         }
     }
@@ -413,41 +372,25 @@ mod tests {
         for mask in [0b111, 0b101] {
             let rest = random_rest(&mut rng);
             let stencil = random_stencil(&mut rng, mask);
-            let rotation: Matrix3<f64> = Rotation3::from_axis_angle(
-                &Unit::new_normalize(rng.vector()),
-                rng.uniform(0.5, 3.0),
-            )
-            .into();
+            let rotation: Matrix3<f64> =
+                Rotation3::from_axis_angle(&Unit::new_normalize(rng.vector()), rng.uniform(0.5, 3.0)).into();
             let shift = rng.vector() * 5.0;
             let moved = Stencil {
                 triangle: stencil.triangle.map(|x| rotation * x + shift),
                 neighbours: stencil.neighbours.map(|n| n.map(|x| rotation * x + shift)),
             };
-            let (d, m) = (
-                forms_with_derivatives(&rest, &stencil),
-                forms_with_derivatives(&rest, &moved),
-            );
+            let (d, m) = (forms_with_derivatives(&rest, &stencil), forms_with_derivatives(&rest, &moved));
             for k in 0..3 {
                 assert_close(m.first[k], d.first[k], 1e-12);
                 assert_close(m.second[k], d.second[k], 1e-12);
             }
             let mut block_rotation = SMatrix::<f64, 18, 18>::zeros();
             for slot in 0..6 {
-                block_rotation
-                    .fixed_view_mut::<3, 3>(3 * slot, 3 * slot)
-                    .copy_from(&rotation);
+                block_rotation.fixed_view_mut::<3, 3>(3 * slot, 3 * slot).copy_from(&rotation);
             }
-            assert_all_close(
-                &m.gradient,
-                &(d.gradient * block_rotation.transpose()),
-                1e-11,
-            );
+            assert_all_close(&m.gradient, &(d.gradient * block_rotation.transpose()), 1e-11);
             for (hm, hd) in m.hessian.iter().zip(&d.hessian) {
-                assert_all_close(
-                    hm,
-                    &(block_rotation * hd * block_rotation.transpose()),
-                    1e-11,
-                );
+                assert_all_close(hm, &(block_rotation * hd * block_rotation.transpose()), 1e-11);
             }
         }
     }
@@ -477,14 +420,11 @@ mod tests {
         grid.triangles
             .iter()
             .filter_map(|t| {
-                let far =
-                    [0, 1, 2].map(|i| far_vertex.get(&(t[(i + 1) % 3], t[(i + 2) % 3])).copied());
+                let far = [0, 1, 2].map(|i| far_vertex.get(&(t[(i + 1) % 3], t[(i + 2) % 3])).copied());
                 far.iter().all(Option::is_some).then(|| {
                     let rest = RestTriangle::new(&t.map(|v| grid.material[v]));
-                    let stencil = Stencil {
-                        triangle: t.map(position),
-                        neighbours: far.map(|f| f.map(position)),
-                    };
+                    let stencil =
+                        Stencil { triangle: t.map(position), neighbours: far.map(|f| f.map(position)) };
                     let centroid = t.iter().map(|&v| grid.material[v]).sum::<Vector2<f64>>() / 3.0;
                     (rest, stencil, centroid)
                 })
@@ -513,17 +453,12 @@ mod tests {
     #[test]
     fn parabola_second_form_is_positive_curvature() {
         let c = 1.5;
-        let stencils = interior_stencils(0.25, 0.25, 0.01, |p| {
-            Vec3::new(p.x, p.y, 0.5 * c * p.x * p.x)
-        });
+        let stencils = interior_stencils(0.25, 0.25, 0.01, |p| Vec3::new(p.x, p.y, 0.5 * c * p.x * p.x));
         assert_forms_near(
             &stencils,
             |p| {
                 let slope = c * p.x;
-                (
-                    [1.0 + slope * slope, 0.0, 1.0],
-                    [c / (1.0 + slope * slope).sqrt(), 0.0, 0.0],
-                )
+                ([1.0 + slope * slope, 0.0, 1.0], [c / (1.0 + slope * slope).sqrt(), 0.0, 0.0])
             },
             0.01,
             0.01 * c,
@@ -554,18 +489,13 @@ mod tests {
     #[test]
     fn paraboloid_second_form_is_isotropic() {
         let c = -2.0;
-        let stencils = interior_stencils(0.2, 0.2, 0.01, |p| {
-            Vec3::new(p.x, p.y, 0.5 * c * p.norm_squared())
-        });
+        let stencils = interior_stencils(0.2, 0.2, 0.01, |p| Vec3::new(p.x, p.y, 0.5 * c * p.norm_squared()));
         assert_forms_near(
             &stencils,
             |p| {
                 let g = c * p;
                 let scale = 1.0 / (1.0 + g.norm_squared()).sqrt();
-                (
-                    [1.0 + g.x * g.x, g.x * g.y, 1.0 + g.y * g.y],
-                    [c * scale, 0.0, c * scale],
-                )
+                ([1.0 + g.x * g.x, g.x * g.y, 1.0 + g.y * g.y], [c * scale, 0.0, c * scale])
             },
             0.01,
             0.01 * c.abs(),
@@ -578,9 +508,8 @@ mod tests {
     fn timing_forms_with_derivatives() {
         let mut rng = XorShift::new(99);
         for mask in [0b111, 0b000] {
-            let cases: Vec<_> = (0..64)
-                .map(|_| (random_rest(&mut rng), random_stencil(&mut rng, mask)))
-                .collect();
+            let cases: Vec<_> =
+                (0..64).map(|_| (random_rest(&mut rng), random_stencil(&mut rng, mask))).collect();
             let mut sink = 0.0;
             let returned = time_per_call(&cases, 4000, |(rest, stencil)| {
                 let d = forms_with_derivatives(rest, std::hint::black_box(stencil));

@@ -108,21 +108,12 @@ pub fn hinge_energy_with_derivatives(rest: &HingeRest, hinge: &[Vec3; 4]) -> Hin
 /// diagonal edge `k_bias`. In between, the stiffness is linear in the angle `φ ∈ [0, π/2]`
 /// between the edge normal and X (`|atan2|` of the normal folded into `[0, π/2]`):
 /// weft at 0, bias at π/4, warp at π/2. Independent of the edge's sign and of mirroring.
-pub fn anisotropic_stiffness(
-    rest_edge_dir: &Vector2<f64>,
-    k_weft: f64,
-    k_bias: f64,
-    k_warp: f64,
-) -> f64 {
+pub fn anisotropic_stiffness(rest_edge_dir: &Vector2<f64>, k_weft: f64, k_bias: f64, k_warp: f64) -> f64 {
     let edge_angle = rest_edge_dir.y.atan2(rest_edge_dir.x).abs();
     let folded_edge_angle = edge_angle.min(std::f64::consts::PI - edge_angle);
     let bend_angle = FRAC_PI_2 - folded_edge_angle;
     let t = bend_angle / FRAC_PI_4;
-    if t <= 1.0 {
-        k_weft + (k_bias - k_weft) * t
-    } else {
-        k_bias + (k_warp - k_bias) * (t - 1.0)
-    }
+    if t <= 1.0 { k_weft + (k_bias - k_weft) * t } else { k_bias + (k_warp - k_bias) * (t - 1.0) }
 }
 
 #[cfg(test)]
@@ -154,20 +145,13 @@ mod tests {
             for _ in 0..10 {
                 let rest = random_rest(&mut rng);
                 let hinge = random_hinge(&mut rng, 2.6);
-                let q =
-                    SVector::<f64, 12>::from_iterator(hinge.iter().flat_map(|v| v.iter().copied()));
+                let q = SVector::<f64, 12>::from_iterator(hinge.iter().flat_map(|v| v.iter().copied()));
                 let d = hinge_energy_with_derivatives(&rest, &hinge);
-                assert_close(
-                    d.energy,
-                    hinge_energy(&rest, &hinge),
-                    1e-12 * d.energy.max(1.0),
-                );
+                assert_close(d.energy, hinge_energy(&rest, &hinge), 1e-12 * d.energy.max(1.0));
                 let fd = fd_gradient(|q| hinge_energy(&rest, &hinge_from(q)), &q);
                 assert_all_close(&d.gradient, &fd, 1e-6);
-                let fd_hessian = fd_jacobian(
-                    |q| hinge_energy_with_derivatives(&rest, &hinge_from(q)).gradient,
-                    &q,
-                );
+                let fd_hessian =
+                    fd_jacobian(|q| hinge_energy_with_derivatives(&rest, &hinge_from(q)).gradient, &q);
                 assert_all_close(&d.hessian, &fd_hessian, 1e-6);
                 assert_eq!(d.hessian, d.hessian.transpose());
             }
@@ -180,17 +164,12 @@ mod tests {
         let rest = random_rest(&mut rng);
         let hinge = random_hinge(&mut rng, 2.0);
         let kappa = hinge_curvature(&rest, &hinge);
-        assert_close(
-            hinge_energy(&rest, &hinge),
-            rest.stiffness * kappa * kappa * rest.area,
-            1e-12,
-        );
+        assert_close(hinge_energy(&rest, &hinge), rest.stiffness * kappa * kappa * rest.area, 1e-12);
     }
 
     #[test]
     fn rest_data_of_unit_square_split() {
-        let square =
-            [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)].map(|(x, y)| Vector2::new(x, y));
+        let square = [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)].map(|(x, y)| Vector2::new(x, y));
         let rest = HingeRest::new(&square, 2.0);
         assert_close(rest.mean_altitude, 0.5f64.sqrt(), 1e-15);
         assert_close(rest.area, 1.0 / 3.0, 1e-15);
@@ -234,10 +213,7 @@ mod tests {
     fn cylinder_area_weighted_curvature_is_inverse_radius() {
         let radius = 0.4;
         let hinges = cylinder_hinges(radius);
-        let weighted: f64 = hinges
-            .iter()
-            .map(|(rest, x, _)| hinge_curvature(rest, x) * rest.area)
-            .sum();
+        let weighted: f64 = hinges.iter().map(|(rest, x, _)| hinge_curvature(rest, x) * rest.area).sum();
         let area: f64 = hinges.iter().map(|(rest, _, _)| rest.area).sum();
         assert_close(weighted / area, 1.0 / radius, 0.01 / radius);
     }
@@ -263,16 +239,12 @@ mod tests {
     #[ignore]
     fn timing_hinge_energy_with_derivatives() {
         let mut rng = XorShift::new(98);
-        let cases: Vec<_> = (0..64)
-            .map(|_| (random_rest(&mut rng), random_hinge(&mut rng, 2.0)))
-            .collect();
+        let cases: Vec<_> = (0..64).map(|_| (random_rest(&mut rng), random_hinge(&mut rng, 2.0))).collect();
         let mut sink = 0.0;
         let timing = time_per_call(&cases, 4000, |(rest, hinge)| {
             let d = hinge_energy_with_derivatives(rest, std::hint::black_box(hinge));
             sink += d.hessian[(4, 9)];
         });
-        println!(
-            "hinge_energy_with_derivatives, µs per hinge (min, median): {timing:.3?} ({sink:.1})"
-        );
+        println!("hinge_energy_with_derivatives, µs per hinge (min, median): {timing:.3?} ({sink:.1})");
     }
 }

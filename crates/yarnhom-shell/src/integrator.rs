@@ -149,7 +149,8 @@ impl Simulation {
         for &v in handles.iter().flat_map(|h| &h.vertices) {
             fixed[3 * v..3 * v + 3].fill(true);
         }
-        let handle_origins = handles.iter().map(|h| h.vertices.iter().map(|&v| positions[v]).collect()).collect();
+        let handle_origins =
+            handles.iter().map(|h| h.vertices.iter().map(|&v| positions[v]).collect()).collect();
         let self_collision = SelfCollision::new(&contact, &model.mesh.material);
         Self {
             velocities: vec![Vector3::zeros(); positions.len()],
@@ -184,7 +185,11 @@ impl Simulation {
     pub fn handle_force_n(&self, k: usize) -> Vector3<f64> {
         let mut a = Assembly::new(3 * self.positions.len());
         self.model.assemble(&self.positions, false, &mut a);
-        self.handles[k].vertices.iter().map(|&v| -Vector3::new(a.gradient[3 * v], a.gradient[3 * v + 1], a.gradient[3 * v + 2])).sum()
+        self.handles[k]
+            .vertices
+            .iter()
+            .map(|&v| -Vector3::new(a.gradient[3 * v], a.gradient[3 * v + 1], a.gradient[3 * v + 2]))
+            .sum()
     }
 
     /// Deepest penetration of any vertex into an obstacle (m), 0 if none.
@@ -207,7 +212,13 @@ impl Simulation {
         let mut x = start.clone();
         self.move_handles(&mut x, next_time);
         let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new() };
-        let mut stats = StepStats { newton_iterations: 0, residual_n: 0.0, line_search_steps: 0, converged: false, wall_time_s: 0.0 };
+        let mut stats = StepStats {
+            newton_iterations: 0,
+            residual_n: 0.0,
+            line_search_steps: 0,
+            converged: false,
+            wall_time_s: 0.0,
+        };
         for iteration in 0..self.dynamics.max_newton_iterations {
             let mut a = self.assemble(&x, &mut terms, iteration == 0);
             self.remove_fixed(&mut a);
@@ -366,8 +377,11 @@ impl Simulation {
         let slope = dot(&a.gradient, dx);
         let mut alpha = 1.0;
         for halvings in 0..30 {
-            let trial: Vec<_> =
-                x.iter().zip(dx.chunks_exact(3)).map(|(p, d)| p + alpha * Vector3::new(d[0], d[1], d[2])).collect();
+            let trial: Vec<_> = x
+                .iter()
+                .zip(dx.chunks_exact(3))
+                .map(|(p, d)| p + alpha * Vector3::new(d[0], d[1], d[2]))
+                .collect();
             let phi = self.potential(&trial, terms);
             if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
                 return (alpha, halvings);

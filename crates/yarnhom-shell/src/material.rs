@@ -120,7 +120,11 @@ impl StvkNeoHookean {
         let ddg = 2.0 * self.k_n1 + 2.0 * self.k_n2 * (1.0 - log_j) / (j * j);
         let gradient = stvk_gradient + dg * d_j;
         let hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
-        let mut jet = EnergyJet { value: 0.5 * eps.dot(&(k * eps)) + g, gradient: Vector6::zeros(), hessian: Default::default() };
+        let mut jet = EnergyJet {
+            value: 0.5 * eps.dot(&(k * eps)) + g,
+            gradient: Vector6::zeros(),
+            hessian: Default::default(),
+        };
         jet.gradient.fixed_rows_mut::<3>(0).copy_from(&gradient);
         jet.hessian.fixed_view_mut::<3, 3>(0, 0).copy_from(&hessian);
         jet

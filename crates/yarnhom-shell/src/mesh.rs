@@ -200,7 +200,10 @@ mod tests {
     fn bad_meshes_are_errors() {
         let m = vec![Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0), Vector2::new(0.0, 1.0)];
         assert_eq!(ShellMesh::new(m.clone(), vec![[0, 2, 1]]), Err(MeshError::BadOrientation(0)));
-        assert!(matches!(ShellMesh::new(m.clone(), vec![[0, 1, 3]]), Err(MeshError::VertexOutOfRange { .. })));
+        assert!(matches!(
+            ShellMesh::new(m.clone(), vec![[0, 1, 3]]),
+            Err(MeshError::VertexOutOfRange { .. })
+        ));
         let four = [m.clone(), vec![Vector2::new(1.0, 1.0)]].concat();
         assert!(matches!(
             ShellMesh::new(four, vec![[0, 1, 2], [0, 1, 3], [1, 0, 2]]),

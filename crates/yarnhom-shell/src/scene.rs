@@ -132,7 +132,13 @@ impl Scene {
             max_newton_iterations: 30,
             tolerance_m: 1e-4,
         };
-        let bar = |side: u8, motion: usize| HandleSpec::Bar { side, length: 0.67, width: 0.07, inset: 0.16, motion: Some(motion) };
+        let bar = |side: u8, motion: usize| HandleSpec::Bar {
+            side,
+            length: 0.67,
+            width: 0.07,
+            inset: 0.16,
+            motion: Some(motion),
+        };
         let pull = |d: [f64; 3]| vec![(0.0, [0.0; 3]), (0.4, d)];
         match name {
             "stretch-x" => Ok(Scene {
@@ -161,7 +167,8 @@ impl Scene {
 
     /// Parse a scene from its JSON text and check it.
     pub fn from_json(text: &str) -> Result<Self, SceneError> {
-        let scene: Scene = serde_json::from_str(text).map_err(|e| SceneError::Parse(format!("scene JSON: {e}")))?;
+        let scene: Scene =
+            serde_json::from_str(text).map_err(|e| SceneError::Parse(format!("scene JSON: {e}")))?;
         scene.validate()?;
         Ok(scene)
     }
@@ -182,7 +189,11 @@ impl Scene {
         let stripped = yarnhom_artifacts::arcsim::strip_comments(&text);
         let value: serde_json::Value =
             serde_json::from_str(&stripped).map_err(|e| SceneError::Parse(format!("{spec}: {e}")))?;
-        if value.get("cloths").is_some() { crate::arcsim_scene::import(&value, name) } else { Self::from_json(&stripped) }
+        if value.get("cloths").is_some() {
+            crate::arcsim_scene::import(&value, name)
+        } else {
+            Self::from_json(&stripped)
+        }
     }
 
     /// Check ranges.
@@ -196,11 +207,16 @@ impl Scene {
         }
         for (k, h) in self.handles.iter().enumerate() {
             let motion = match h {
-                HandleSpec::Bar { side, motion, .. } if *side > 3 => return bad(format!("handle {k}: side {side} is not 0-3")),
+                HandleSpec::Bar { side, motion, .. } if *side > 3 => {
+                    return bad(format!("handle {k}: side {side} is not 0-3"));
+                }
                 HandleSpec::Bar { motion, .. } | HandleSpec::Sphere { motion, .. } => *motion,
             };
             if let Some(m) = motion.filter(|&m| m >= self.motions.len()) {
-                return bad(format!("handle {k}: motion {m} does not exist ({} motions)", self.motions.len()));
+                return bad(format!(
+                    "handle {k}: motion {m} does not exist ({} motions)",
+                    self.motions.len()
+                ));
             }
         }
         Ok(())
@@ -224,14 +240,19 @@ impl Scene {
             .iter()
             .enumerate()
             .map(|(k, spec)| {
-                let mut vertices: Vec<usize> = (0..positions.len()).filter(|&v| self.holds(spec, &positions[v])).collect();
+                let mut vertices: Vec<usize> =
+                    (0..positions.len()).filter(|&v| self.holds(spec, &positions[v])).collect();
                 if let (true, HandleSpec::Sphere { center, .. }) = (vertices.is_empty(), spec) {
                     // A coarse mesh may have no vertex inside a small sphere: hold the nearest.
                     let distance = |v: usize| (positions[v] - Vector3::from(*center)).norm();
-                    vertices.extend((0..positions.len()).min_by(|&a, &b| distance(a).total_cmp(&distance(b))));
+                    vertices
+                        .extend((0..positions.len()).min_by(|&a, &b| distance(a).total_cmp(&distance(b))));
                 }
                 if vertices.is_empty() {
-                    return Err(SceneError::Invalid { scene: self.name.clone(), problem: format!("handle {k} holds no vertex") });
+                    return Err(SceneError::Invalid {
+                        scene: self.name.clone(),
+                        problem: format!("handle {k} holds no vertex"),
+                    });
                 }
                 let motion = match spec {
                     HandleSpec::Bar { motion, .. } | HandleSpec::Sphere { motion, .. } => *motion,

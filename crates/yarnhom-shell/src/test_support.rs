@@ -25,11 +25,7 @@ impl XorShift {
     }
 
     pub fn vector(&mut self) -> Vec3 {
-        Vec3::new(
-            self.uniform(-1.0, 1.0),
-            self.uniform(-1.0, 1.0),
-            self.uniform(-1.0, 1.0),
-        )
+        Vec3::new(self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0), self.uniform(-1.0, 1.0))
     }
 }
 
@@ -38,9 +34,7 @@ pub fn random_triangle(rng: &mut XorShift) -> [Vec3; 3] {
     loop {
         let t = [rng.vector(), rng.vector(), rng.vector()];
         let double_area = (t[1] - t[0]).cross(&(t[2] - t[0])).norm();
-        let longest = (0..3)
-            .map(|i| (t[(i + 1) % 3] - t[i]).norm())
-            .fold(0.0, f64::max);
+        let longest = (0..3).map(|i| (t[(i + 1) % 3] - t[i]).norm()).fold(0.0, f64::max);
         if double_area / longest >= 0.3 * longest {
             return t;
         }
@@ -112,10 +106,7 @@ pub fn assert_all_close<const R: usize, const C: usize>(
 
 /// `|a - b| ≤ tol`.
 pub fn assert_close(actual: f64, expected: f64, tol: f64) {
-    assert!(
-        (actual - expected).abs() <= tol,
-        "{actual} vs {expected} (tol {tol:e})"
-    );
+    assert!((actual - expected).abs() <= tol, "{actual} vs {expected} (tol {tol:e})");
 }
 
 /// A regular grid on `[-half_x, half_x] × [-half_y, half_y]` with spacing `h`, each square split
@@ -127,10 +118,7 @@ pub struct GridMesh {
 
 impl GridMesh {
     pub fn new(half_x: f64, half_y: f64, h: f64) -> Self {
-        let (nx, ny) = (
-            (2.0 * half_x / h).round() as usize,
-            (2.0 * half_y / h).round() as usize,
-        );
+        let (nx, ny) = ((2.0 * half_x / h).round() as usize, (2.0 * half_y / h).round() as usize);
         let index = |i: usize, j: usize| i * (ny + 1) + j;
         let material = (0..=nx)
             .flat_map(|i| (0..=ny).map(move |j| (i, j)))
@@ -143,10 +131,7 @@ impl GridMesh {
                 triangles.push([index(i + 1, j), index(i + 1, j + 1), index(i, j + 1)]);
             }
         }
-        Self {
-            material,
-            triangles,
-        }
+        Self { material, triangles }
     }
 
     /// Directed edge `(p, q)` → apex of the triangle traversing `q → p`, i.e. the far vertex

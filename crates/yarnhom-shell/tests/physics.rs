@@ -11,7 +11,9 @@ use yarnhom_shell::{Scene, ShellMaterial, Simulation};
 
 fn published(name: &str) -> ShellMaterial {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    ShellMaterial::spline(SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published material")))
+    ShellMaterial::spline(SplineMaterial::from(
+        &read_spline(std::path::Path::new(&path)).expect("published material"),
+    ))
 }
 
 /// A builtin at `n x n` vertices with `steps` steps per 1/60 s frame.
@@ -40,7 +42,8 @@ fn middle_width(sim: &Simulation) -> f64 {
         .filter(|(m, _)| m.x.abs() < 0.02)
         .map(|(_, p)| p)
         .collect();
-    let (lo, hi) = middle.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+    let (lo, hi) =
+        middle.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
     hi - lo
 }
 
@@ -122,7 +125,10 @@ fn relaxation_without_driving_never_gains_energy() {
     for step in 0..30 {
         sim.step().expect("step");
         let now = total(&sim);
-        assert!(now <= last * (1.0 + 1e-9) + 1e-12, "step {step}: energy rose from {last:.6e} to {now:.6e} J");
+        assert!(
+            now <= last * (1.0 + 1e-9) + 1e-12,
+            "step {step}: energy rose from {last:.6e} to {now:.6e} J"
+        );
         last = now;
     }
     eprintln!("relaxation: {first:.3e} -> {last:.3e} J");
@@ -145,5 +151,9 @@ fn a_patch_draped_on_a_sphere_comes_to_rest_without_penetrating_it() {
     let centre = sim.positions.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
     eprintln!("drape: lowest {centre:.4} m, kinetic {:.2e} J (peak {peak:.2e} J)", sim.kinetic_energy());
     assert!(centre < -0.05, "the cloth hangs over the sphere (lowest point {centre:.3} m)");
-    assert!(sim.kinetic_energy() < 0.05 * peak, "at rest: kinetic {:.2e} J vs peak {peak:.2e} J", sim.kinetic_energy());
+    assert!(
+        sim.kinetic_energy() < 0.05 * peak,
+        "at rest: kinetic {:.2e} J vs peak {peak:.2e} J",
+        sim.kinetic_energy()
+    );
 }

@@ -73,8 +73,8 @@ mod writer;
 
 pub use error::TraceError;
 pub use messages::{
-    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep,
-    TOPIC_VERSION_KEY, Topic, topics,
+    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep, TOPIC_VERSION_KEY,
+    Topic, topics,
 };
 pub use metadata::{METADATA_NAME, TraceMetadata, read_metadata};
 pub use reader::{TraceMessage, TraceReader};

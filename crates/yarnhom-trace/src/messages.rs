@@ -122,12 +122,7 @@ macro_rules! topic {
     };
 }
 
-topic!(
-    MeshTopology,
-    topics::MESH_TOPOLOGY,
-    "yarnhom.MeshTopology.v1",
-    1
-);
+topic!(MeshTopology, topics::MESH_TOPOLOGY, "yarnhom.MeshTopology.v1", 1);
 topic!(MeshFrame, topics::MESH_FRAME, "yarnhom.MeshFrame.v1", 1);
 topic!(Scalars, topics::METRICS, "yarnhom.Scalars.v1", 1);
 topic!(SolverStep, topics::SOLVER, "yarnhom.SolverStep.v1", 1);
@@ -180,9 +175,6 @@ mod tests {
     fn field_docs_reach_the_schema() {
         let schema = serde_json::to_value(MeshFrame::root_schema()).expect("schema json");
         let description = &schema["properties"]["positions_m"]["description"];
-        assert!(
-            description.as_str().is_some_and(|d| d.contains("metres")),
-            "{schema:#}"
-        );
+        assert!(description.as_str().is_some_and(|d| d.contains("metres")), "{schema:#}");
     }
 }

@@ -51,38 +51,23 @@ impl TraceMetadata {
 
     /// Builds the MCAP metadata record.
     pub(crate) fn to_record(&self) -> Result<mcap::records::Metadata, TraceError> {
-        if let Some(key) = self
-            .entries
-            .keys()
-            .find(|key| RESERVED_KEYS.contains(&key.as_str()))
-        {
+        if let Some(key) = self.entries.keys().find(|key| RESERVED_KEYS.contains(&key.as_str())) {
             return Err(TraceError::ReservedMetadataKey { key: key.clone() });
         }
         let mut metadata = self.entries.clone();
         metadata.insert(KEY_PRODUCER_NAME.into(), self.producer_name.clone());
         metadata.insert(KEY_PRODUCER_VERSION.into(), self.producer_version.clone());
         metadata.insert(KEY_WRITER.into(), env!("CARGO_PKG_VERSION").into());
-        Ok(mcap::records::Metadata {
-            name: METADATA_NAME.into(),
-            metadata,
-        })
+        Ok(mcap::records::Metadata { name: METADATA_NAME.into(), metadata })
     }
 
     /// Parses the key/values of a `yarnhom` metadata record. The writer-version key is dropped.
     pub(crate) fn from_record(mut metadata: BTreeMap<String, String>) -> Result<Self, TraceError> {
-        let mut take = |key: &'static str| {
-            metadata
-                .remove(key)
-                .ok_or(TraceError::MissingMetadataKey { key })
-        };
+        let mut take = |key: &'static str| metadata.remove(key).ok_or(TraceError::MissingMetadataKey { key });
         let producer_name = take(KEY_PRODUCER_NAME)?;
         let producer_version = take(KEY_PRODUCER_VERSION)?;
         metadata.remove(KEY_WRITER);
-        Ok(Self {
-            producer_name,
-            producer_version,
-            entries: metadata,
-        })
+        Ok(Self { producer_name, producer_version, entries: metadata })
     }
 }
 
@@ -114,14 +99,8 @@ mod tests {
         let record = meta.to_record().expect("record");
         assert_eq!(record.name, "yarnhom");
         assert_eq!(record.metadata["producer_name"], "sim");
-        assert_eq!(
-            record.metadata["yarnhom_trace_version"],
-            env!("CARGO_PKG_VERSION")
-        );
-        assert_eq!(
-            TraceMetadata::from_record(record.metadata).expect("parse"),
-            meta
-        );
+        assert_eq!(record.metadata["yarnhom_trace_version"], env!("CARGO_PKG_VERSION"));
+        assert_eq!(TraceMetadata::from_record(record.metadata).expect("parse"), meta);
     }
 
     #[test]

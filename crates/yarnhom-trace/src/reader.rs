@@ -4,8 +4,7 @@ use std::io::Read;
 
 use crate::TraceError;
 use crate::messages::{
-    MESSAGE_ENCODING, MeshFrame, MeshTopology, Scalars, SolverStep, TOPIC_VERSION_KEY, Topic,
-    topics,
+    MESSAGE_ENCODING, MeshFrame, MeshTopology, Scalars, SolverStep, TOPIC_VERSION_KEY, Topic, topics,
 };
 
 /// One decoded message of a trace.
@@ -48,9 +47,7 @@ pub struct TraceReader<R: Read> {
 impl<R: Read> TraceReader<R> {
     /// Starts reading a trace from `source`.
     pub fn new(source: R) -> Self {
-        Self {
-            messages: mcap::io::MessageReader::new(source),
-        }
+        Self { messages: mcap::io::MessageReader::new(source) }
     }
 
     /// Returns the underlying source.
@@ -77,9 +74,7 @@ fn decode(message: &mcap::Message<'_>) -> Result<TraceMessage, TraceError> {
         topics::MESH_FRAME => TraceMessage::Frame(decode_as(message)?),
         topics::METRICS => TraceMessage::Scalars(decode_as(message)?),
         topics::SOLVER => TraceMessage::Solver(decode_as(message)?),
-        other => TraceMessage::Unknown {
-            topic: other.to_owned(),
-        },
+        other => TraceMessage::Unknown { topic: other.to_owned() },
     })
 }
 
@@ -100,8 +95,6 @@ fn decode_as<T: Topic>(message: &mcap::Message<'_>) -> Result<T, TraceError> {
             supported: T::VERSION,
         });
     }
-    rmp_serde::from_slice(&message.data).map_err(|source| TraceError::Decode {
-        topic: channel.topic.clone(),
-        source,
-    })
+    rmp_serde::from_slice(&message.data)
+        .map_err(|source| TraceError::Decode { topic: channel.topic.clone(), source })
 }

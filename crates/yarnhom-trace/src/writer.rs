@@ -11,8 +11,7 @@ use mcap::records::MessageHeader;
 use mcap::write::NoSeek;
 
 use crate::messages::{
-    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep,
-    TOPIC_VERSION_KEY, Topic,
+    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep, TOPIC_VERSION_KEY, Topic,
 };
 use crate::{TraceError, TraceMetadata};
 
@@ -31,10 +30,7 @@ pub struct TraceWriterOptions {
 
 impl Default for TraceWriterOptions {
     fn default() -> Self {
-        Self {
-            chunk_size: DEFAULT_CHUNK_SIZE,
-            compress: true,
-        }
+        Self { chunk_size: DEFAULT_CHUNK_SIZE, compress: true }
     }
 }
 
@@ -64,11 +60,7 @@ impl TraceWriterOptions {
         mcap::WriteOptions::new()
             .compression(self.compress.then_some(mcap::Compression::Zstd))
             .chunk_size(Some(self.chunk_size))
-            .library(format!(
-                "yarnhom-trace/{}; {}",
-                env!("CARGO_PKG_VERSION"),
-                mcap::LIBRARY_IDENTIFIER
-            ))
+            .library(format!("yarnhom-trace/{}; {}", env!("CARGO_PKG_VERSION"), mcap::LIBRARY_IDENTIFIER))
             .disable_seeking(!seeking)
     }
 
@@ -230,17 +222,13 @@ impl<W: Write + Seek> TraceWriter<W> {
 
     fn channel<T: Topic>(&mut self) -> Result<&mut ChannelState, TraceError> {
         if !self.channels.contains_key(T::TOPIC) {
-            let schema =
-                serde_json::to_vec(&T::root_schema()).map_err(|source| TraceError::Schema {
-                    topic: T::TOPIC,
-                    source,
-                })?;
+            let schema = serde_json::to_vec(&T::root_schema())
+                .map_err(|source| TraceError::Schema { topic: T::TOPIC, source })?;
             let metadata = BTreeMap::from([(TOPIC_VERSION_KEY.to_owned(), T::VERSION.to_string())]);
             let mcap = self.mcap();
             let schema_id = mcap.add_schema(T::SCHEMA_NAME, SCHEMA_ENCODING, &schema)?;
             let id = mcap.add_channel(schema_id, T::TOPIC, MESSAGE_ENCODING, &metadata)?;
-            self.channels
-                .insert(T::TOPIC, ChannelState { id, count: 0 });
+            self.channels.insert(T::TOPIC, ChannelState { id, count: 0 });
         }
         match self.channels.get_mut(T::TOPIC) {
             Some(state) => Ok(state),
@@ -254,12 +242,8 @@ impl<W: Write + Seek> TraceWriter<W> {
             None => 0,
         };
         self.buf.clear();
-        rmp_serde::encode::write_named(&mut self.buf, message).map_err(|source| {
-            TraceError::Encode {
-                topic: T::TOPIC,
-                source,
-            }
-        })?;
+        rmp_serde::encode::write_named(&mut self.buf, message)
+            .map_err(|source| TraceError::Encode { topic: T::TOPIC, source })?;
         let channel = self.channel::<T>()?;
         // MCAP sequences are 32-bit: the frame number wraps (the message keeps all 64 bits).
         let sequence = match message.frame() {
@@ -267,12 +251,7 @@ impl<W: Write + Seek> TraceWriter<W> {
             None => channel.count,
         };
         channel.count = channel.count.wrapping_add(1);
-        let header = MessageHeader {
-            channel_id: channel.id,
-            sequence,
-            log_time,
-            publish_time: log_time,
-        };
+        let header = MessageHeader { channel_id: channel.id, sequence, log_time, publish_time: log_time };
         let Some(mcap) = self.mcap.as_mut() else {
             unreachable!("the MCAP writer is only taken by finish() and drop()")
         };
@@ -339,11 +318,7 @@ impl AtomicFile {
                 COUNTER.fetch_add(1, Ordering::Relaxed)
             ));
             let temp_path = dir.join(temp_name);
-            match OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&temp_path)
-            {
+            match OpenOptions::new().write(true).create_new(true).open(&temp_path) {
                 Ok(file) => {
                     return Ok(Self {
                         file: Some(BufWriter::new(file)),
@@ -370,17 +345,12 @@ impl AtomicFile {
     }
 
     fn file(&mut self) -> io::Result<&mut BufWriter<File>> {
-        self.file
-            .as_mut()
-            .ok_or_else(|| io::Error::other("the trace file is already closed"))
+        self.file.as_mut().ok_or_else(|| io::Error::other("the trace file is already closed"))
     }
 
     /// Flushes, syncs and closes the temporary file, then renames it to the destination.
     fn commit(&mut self) -> io::Result<()> {
-        let file = self
-            .file
-            .take()
-            .ok_or_else(|| io::Error::other("the trace file is already closed"))?;
+        let file = self.file.take().ok_or_else(|| io::Error::other("the trace file is already closed"))?;
         let file = file.into_inner().map_err(io::IntoInnerError::into_error)?;
         file.sync_all()?;
         drop(file);
@@ -390,11 +360,7 @@ impl AtomicFile {
         // the trace is complete either way, so this is best effort.
         #[cfg(unix)]
         if let Some(dir) = self.final_path.parent() {
-            let dir = if dir.as_os_str().is_empty() {
-                Path::new(".")
-            } else {
-                dir
-            };
+            let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
             if let Ok(dir) = File::open(dir) {
                 let _ = dir.sync_all();
             }

@@ -20,12 +20,7 @@ fn scratch_dir(name: &str) -> PathBuf {
 fn topology() -> MeshTopology {
     MeshTopology {
         triangles: vec![[0, 1, 2], [0, 2, 3]],
-        rest_positions_m: vec![
-            [0.0, 0.0, 0.0],
-            [0.01, 0.0, 0.0],
-            [0.01, 0.01, 0.0],
-            [0.0, 0.01, 0.0],
-        ],
+        rest_positions_m: vec![[0.0, 0.0, 0.0], [0.01, 0.0, 0.0], [0.01, 0.01, 0.0], [0.0, 0.01, 0.0]],
         name: "cloth".into(),
     }
 }
@@ -36,9 +31,7 @@ fn frame(i: u64) -> MeshFrame {
         mesh: "cloth".into(),
         frame: i,
         time_s: t,
-        positions_m: (0..4)
-            .map(|v| [v as f64 * 0.01, (v / 2) as f64 * 0.01, -0.5 * 9.81 * t * t])
-            .collect(),
+        positions_m: (0..4).map(|v| [v as f64 * 0.01, (v / 2) as f64 * 0.01, -0.5 * 9.81 * t * t]).collect(),
     }
 }
 
@@ -91,9 +84,7 @@ fn write_trace<W: Write + Seek>(writer: &mut TraceWriter<W>) -> Vec<TraceMessage
 }
 
 fn read_all(source: impl Read) -> Vec<TraceMessage> {
-    TraceReader::new(source)
-        .collect::<Result<Vec<_>, _>>()
-        .expect("read trace")
+    TraceReader::new(source).collect::<Result<Vec<_>, _>>().expect("read trace")
 }
 
 #[test]
@@ -103,19 +94,11 @@ fn file_round_trip_is_atomic_and_identical() {
     let mut writer = TraceWriter::create(&path).expect("create");
     let written = write_trace(&mut writer);
     assert!(!path.exists(), "the trace must not appear before finish()");
-    assert_eq!(
-        std::fs::read_dir(&dir).expect("ls").count(),
-        1,
-        "one temp file"
-    );
+    assert_eq!(std::fs::read_dir(&dir).expect("ls").count(), 1, "one temp file");
     let file = writer.finish().expect("finish");
     assert!(file.is_committed());
     assert_eq!(file.path(), path);
-    assert_eq!(
-        std::fs::read_dir(&dir).expect("ls").count(),
-        1,
-        "the temp file was renamed, not copied"
-    );
+    assert_eq!(std::fs::read_dir(&dir).expect("ls").count(), 1, "the temp file was renamed, not copied");
 
     let read = read_all(std::fs::File::open(&path).expect("open"));
     assert_eq!(read, written);
@@ -139,11 +122,7 @@ fn dropping_an_unfinished_file_writer_leaves_nothing() {
         write_trace(&mut writer);
     }
     assert_eq!(std::fs::read(&path).expect("read"), b"previous contents");
-    assert_eq!(
-        std::fs::read_dir(&dir).expect("ls").count(),
-        1,
-        "temp file removed"
-    );
+    assert_eq!(std::fs::read_dir(&dir).expect("ls").count(), 1, "temp file removed");
 }
 
 /// A sink that is only `Write`: no `Seek`, like a pipe.
@@ -175,10 +154,8 @@ impl Read for Trickle<'_> {
 
 /// Writes the standard trace through a non-seekable sink, with small chunks so there are many.
 fn pipe_bytes() -> (Vec<u8>, Vec<TraceMessage>) {
-    let mut writer = TraceWriterOptions::new()
-        .chunk_size(4 * 1024)
-        .non_seeking(Pipe::default())
-        .expect("writer");
+    let mut writer =
+        TraceWriterOptions::new().chunk_size(4 * 1024).non_seeking(Pipe::default()).expect("writer");
     let written = write_trace(&mut writer);
     let bytes = writer.finish().expect("finish").into_inner().0;
     (bytes, written)
@@ -194,21 +171,12 @@ fn pipe_round_trip_is_identical() {
 
 #[test]
 fn uncompressed_round_trip_is_identical() {
-    let mut writer = TraceWriterOptions::new()
-        .compression(false)
-        .non_seeking(Pipe::default())
-        .expect("writer");
+    let mut writer =
+        TraceWriterOptions::new().compression(false).non_seeking(Pipe::default()).expect("writer");
     let written = write_trace(&mut writer);
     let bytes = writer.finish().expect("finish").into_inner().0;
-    let summary = mcap::Summary::read(&bytes)
-        .expect("summary")
-        .expect("present");
-    assert!(
-        summary
-            .chunk_indexes
-            .iter()
-            .all(|c| c.compression.is_empty())
-    );
+    let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
+    assert!(summary.chunk_indexes.iter().all(|c| c.compression.is_empty()));
     assert_eq!(read_all(bytes.as_slice()), written);
 }
 
@@ -239,30 +207,20 @@ fn abandoned_stream_is_reported_as_truncated() {
     let items: Vec<_> = TraceReader::new(bytes.as_slice()).collect();
     let (last, rest) = items.split_last().expect("items");
     assert!(rest.iter().all(Result::is_ok));
-    assert_eq!(
-        rest.len(),
-        1 + 3 * FRAMES as usize,
-        "every flushed message is readable"
-    );
-    assert!(
-        matches!(last, Err(TraceError::Mcap(_))),
-        "a missing end must be an error, got {last:?}"
-    );
+    assert_eq!(rest.len(), 1 + 3 * FRAMES as usize, "every flushed message is readable");
+    assert!(matches!(last, Err(TraceError::Mcap(_))), "a missing end must be an error, got {last:?}");
 }
 
 #[test]
 fn stored_schemas_are_the_schemars_output() {
     let (bytes, _) = pipe_bytes();
-    let summary = mcap::Summary::read(&bytes)
-        .expect("summary")
-        .expect("present");
+    let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
     let mut seen = BTreeMap::new();
     for channel in summary.channels.values() {
         let schema = channel.schema.as_ref().expect("every channel has a schema");
         assert_eq!(schema.encoding, "jsonschema");
         assert_eq!(channel.message_encoding, "msgpack");
-        let stored: serde_json::Value =
-            serde_json::from_slice(&schema.data).expect("schema parses as JSON");
+        let stored: serde_json::Value = serde_json::from_slice(&schema.data).expect("schema parses as JSON");
         seen.insert(channel.topic.clone(), (schema.name.clone(), stored));
         assert_eq!(channel.metadata["yarnhom_topic_version"], "1");
     }
@@ -284,17 +242,12 @@ fn stored_schemas_are_the_schemars_output() {
 fn file_passes_mcap_summary_and_indexed_reads() {
     let dir = scratch_dir("indexed");
     let path = dir.join("trace.mcap");
-    let mut writer = TraceWriterOptions::new()
-        .chunk_size(8 * 1024)
-        .create(&path)
-        .expect("create");
+    let mut writer = TraceWriterOptions::new().chunk_size(8 * 1024).create(&path).expect("create");
     write_trace(&mut writer);
     writer.finish().expect("finish");
     let bytes = std::fs::read(&path).expect("read");
 
-    let summary = mcap::Summary::read(&bytes)
-        .expect("summary")
-        .expect("present");
+    let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
     let stats = summary.stats.as_ref().expect("statistics");
     assert_eq!(stats.message_count, 1 + 3 * FRAMES);
     assert_eq!(stats.channel_count, 4);
@@ -304,29 +257,18 @@ fn file_passes_mcap_summary_and_indexed_reads() {
     assert_eq!(stats.message_end_time, (FRAMES - 1) * 1_000_000);
     assert!(stats.chunk_count > 1, "small chunks: {}", stats.chunk_count);
     let count_of = |topic: &str| {
-        let id = summary
-            .channels
-            .values()
-            .find(|c| c.topic == topic)
-            .expect("channel")
-            .id;
+        let id = summary.channels.values().find(|c| c.topic == topic).expect("channel").id;
         stats.channel_message_counts[&id]
     };
     assert_eq!(count_of("/mesh/topology"), 1);
     assert_eq!(count_of("/mesh/frame"), FRAMES);
     assert_eq!(count_of("/metrics"), FRAMES);
     assert_eq!(count_of("/solver"), FRAMES);
-    assert!(
-        summary
-            .chunk_indexes
-            .iter()
-            .all(|c| c.compression == "zstd")
-    );
+    assert!(summary.chunk_indexes.iter().all(|c| c.compression == "zstd"));
 
     // Metadata through the metadata index.
     assert_eq!(summary.metadata_indexes.len(), 1);
-    let metadata =
-        mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).expect("indexed metadata");
+    let metadata = mcap::read::metadata(&bytes, &summary.metadata_indexes[0]).expect("indexed metadata");
     assert_eq!(metadata.name, "yarnhom");
     assert_eq!(metadata.metadata["producer_name"], "roundtrip-test");
 
@@ -352,9 +294,7 @@ fn file_passes_mcap_summary_and_indexed_reads() {
                 file.seek(io::SeekFrom::Start(offset)).expect("seek");
                 buffer.resize(length, 0);
                 file.read_exact(&mut buffer).expect("read chunk");
-                reader
-                    .insert_chunk_record_data(offset, &buffer)
-                    .expect("insert chunk");
+                reader.insert_chunk_record_data(offset, &buffer).expect("insert chunk");
             }
             mcap::sans_io::IndexedReadEvent::Message { header, data } => {
                 total += 1;
@@ -373,10 +313,8 @@ fn file_passes_mcap_summary_and_indexed_reads() {
     assert_eq!(frames, (0..FRAMES).map(frame).collect::<Vec<_>>());
 
     // And the slice-based linear reader of the MCAP library.
-    let linear = mcap::MessageStream::new(&bytes)
-        .expect("stream")
-        .collect::<Result<Vec<_>, _>>()
-        .expect("messages");
+    let linear =
+        mcap::MessageStream::new(&bytes).expect("stream").collect::<Result<Vec<_>, _>>().expect("messages");
     assert_eq!(linear.len() as u64, 1 + 3 * FRAMES);
 }
 
@@ -385,31 +323,18 @@ fn unknown_topics_are_reported_and_bad_messages_name_their_topic() {
     use std::collections::BTreeMap;
     let mut bytes = Vec::new();
     {
-        let mut mcap = mcap::WriteOptions::new()
-            .create(io::Cursor::new(&mut bytes))
-            .expect("mcap");
-        let other = mcap
-            .add_channel(0, "/camera", "raw", &BTreeMap::new())
-            .expect("channel");
+        let mut mcap = mcap::WriteOptions::new().create(io::Cursor::new(&mut bytes)).expect("mcap");
+        let other = mcap.add_channel(0, "/camera", "raw", &BTreeMap::new()).expect("channel");
         let v1 = BTreeMap::from([("yarnhom_topic_version".to_owned(), "1".to_owned())]);
         let v2 = BTreeMap::from([("yarnhom_topic_version".to_owned(), "2".to_owned())]);
-        let garbage = mcap
-            .add_channel(0, "/mesh/frame", "msgpack", &v1)
-            .expect("ch");
+        let garbage = mcap.add_channel(0, "/mesh/frame", "msgpack", &v1).expect("ch");
         let future = mcap.add_channel(0, "/solver", "msgpack", &v2).expect("ch");
         let json = mcap.add_channel(0, "/metrics", "json", &v1).expect("ch");
-        for (channel_id, data) in [
-            (other, &b"\x01\x02"[..]),
-            (garbage, &b"\xc1"[..]),
-            (future, &b"\x80"[..]),
-            (json, &b"{}"[..]),
-        ] {
-            let header = mcap::records::MessageHeader {
-                channel_id,
-                sequence: 0,
-                log_time: 0,
-                publish_time: 0,
-            };
+        for (channel_id, data) in
+            [(other, &b"\x01\x02"[..]), (garbage, &b"\xc1"[..]), (future, &b"\x80"[..]), (json, &b"{}"[..])]
+        {
+            let header =
+                mcap::records::MessageHeader { channel_id, sequence: 0, log_time: 0, publish_time: 0 };
             mcap.write_to_known_channel(&header, data).expect("write");
         }
         mcap.finish().expect("finish");
@@ -428,9 +353,7 @@ fn unknown_topics_are_reported_and_bad_messages_name_their_topic() {
         TraceError::UnsupportedTopicVersion { topic, found: Some(v), supported: 1 }
             if topic == "/solver" && v == "2"
     ));
-    assert!(
-        matches!(err(3), TraceError::UnsupportedEncoding { encoding, .. } if encoding == "json")
-    );
+    assert!(matches!(err(3), TraceError::UnsupportedEncoding { encoding, .. } if encoding == "json"));
 }
 
 #[test]
@@ -444,22 +367,8 @@ fn garbage_input_is_an_mcap_error() {
 fn invalid_times_are_refused() {
     let mut writer = TraceWriter::non_seeking(Pipe::default()).expect("writer");
     let err = writer
-        .write_frame(&MeshFrame {
-            mesh: "cloth".into(),
-            frame: 0,
-            time_s: f64::NAN,
-            positions_m: vec![],
-        })
+        .write_frame(&MeshFrame { mesh: "cloth".into(), frame: 0, time_s: f64::NAN, positions_m: vec![] })
         .expect_err("NaN time");
-    assert!(
-        matches!(
-            err,
-            TraceError::InvalidTime {
-                topic: "/mesh/frame",
-                ..
-            }
-        ),
-        "{err}"
-    );
+    assert!(matches!(err, TraceError::InvalidTime { topic: "/mesh/frame", .. }), "{err}");
     writer.finish().expect("the writer is still usable");
 }
