@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::arcsim::{ArcsimMaterial, read_spline};
 use yarnhom_artifacts::{AnyArtifact, FitSettings, Grid, InputRef, Spline, container};
-use yarnhom_fit::{SplineMaterial, fit_errors, fit_grid};
+use yarnhom_fit::{SplineMaterial, fit_errors, fit_grid, term_shapes};
 
 use crate::Outcome;
 use crate::inputs::{self, provenance};
@@ -175,6 +175,7 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
     container::write(output, &spline, &provenance("fit", vec![input]))?;
     println!("{}", spline.summary());
     print_errors(&grid, &spline);
+    print_shapes(&grid, &spline);
     println!("wrote {}", output.display());
     Ok(Outcome::Success)
 }
@@ -194,6 +195,24 @@ fn print_errors(grid: &Grid, spline: &Spline) {
             100.0 * e.relative_rms,
             100.0 * e.relative_rms_deformation
         );
+    }
+}
+
+/// Whether each quasiconvexified term has a single minimum along its lines (A.36).
+fn print_shapes(grid: &Grid, spline: &Spline) {
+    println!(
+        "single minimum along every line through the control points, over 1.5x the sampled range (A.36):"
+    );
+    for shape in term_shapes(grid, spline, 1e-6) {
+        match shape.violations.first() {
+            None => println!("  {:8} yes ({} lines)", shape.term, shape.lines),
+            Some(first) => println!(
+                "  {:8} NO on {} of {} lines, e.g. {first}",
+                shape.term,
+                shape.violations.len(),
+                shape.lines
+            ),
+        }
     }
 }
 

@@ -6,6 +6,7 @@
 //!   1980; App. B).
 //! - [`march`]: quasiconvex marching (A.36) and increasing extrapolation (A.3.5).
 //! - [`residual`]: residualization (A.37, A.38).
+//! - [`shape`]: single-minimum checks of the fitted terms (A.36).
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
 //! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
@@ -20,7 +21,9 @@ pub mod mls;
 pub mod monotone_bicubic;
 pub mod monotone_cubic;
 pub mod residual;
+pub mod shape;
 pub mod synthetic;
 
 pub use fit::{FitError, TermError, fit_errors, fit_grid};
 pub use material::{EnergyJet, SplineMaterial};
+pub use shape::{TermShape, term_shapes};

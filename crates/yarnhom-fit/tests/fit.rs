@@ -5,8 +5,9 @@
 
 use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values, strain_values};
 use yarnhom_artifacts::{FitSettings, Grid, Spline, StrainSample};
+use yarnhom_fit::shape::unimodality_violation;
 use yarnhom_fit::synthetic::{F0, KX_MIN, LOWER, UPPER, linspace, synthetic_grid};
-use yarnhom_fit::{FitError, SplineMaterial, fit_errors, fit_grid};
+use yarnhom_fit::{FitError, SplineMaterial, fit_errors, fit_grid, term_shapes};
 
 fn fit(grid: &Grid) -> (Spline, SplineMaterial) {
     let spline = fit_grid(grid, &FitSettings::default(), 0.3).expect("the synthetic grid fits");
@@ -21,28 +22,6 @@ fn strain_along(axes: &[u8], values: &[f64]) -> StrainSample {
         v[a as usize] = x;
     }
     strain_from_values(v)
-}
-
-/// Where `ys` (ordered) stops being unimodal: `None` if it does not rise more than `tol` above
-/// its running minimum before its global minimum, nor fall more than `tol` below its running
-/// maximum after it (plateaus are allowed); else the offending index.
-fn unimodality_violation(ys: &[f64], tol: f64) -> Option<usize> {
-    let m = (0..ys.len()).min_by(|&a, &b| ys[a].total_cmp(&ys[b]))?;
-    let mut low = ys[0];
-    for (i, &y) in ys.iter().enumerate().take(m + 1) {
-        if y > low + tol {
-            return Some(i);
-        }
-        low = low.min(y);
-    }
-    let mut high = ys[m];
-    for (i, &y) in ys.iter().enumerate().skip(m) {
-        if y < high - tol {
-            return Some(i);
-        }
-        high = high.max(y);
-    }
-    None
 }
 
 /// Number of strict local minima of `ys`, a run of equal values counting as one point.
@@ -115,44 +94,14 @@ fn value_range(ys: &[f64]) -> f64 {
 /// The marched 2D terms (all but `f_{sx,sy}`, A.3.4) must be quasiconvex: the fitted energy on
 /// the term's plane, `f0 + f_u + f_v + f_uv` (the regularized `f*` of A.3.6 that the marching
 /// acts on), has at most one local minimum along every line through the term's knots, over 1.5
-/// times the sampled range (plateaus allowed, up to 1e-6 of the energy range of the plane);
-/// returns the violations.
+/// times the sampled range (plateaus allowed, up to 1e-6 of the energy range); returns the
+/// violations ([`yarnhom_fit::shape`], also printed by `yarnhom fit`).
 fn quasiconvexity_failures(grid: &Grid, spline: &Spline) -> Vec<String> {
-    let material = SplineMaterial::from(spline);
-    let mut failures = Vec::new();
-    for term in spline.terms_2d.iter().filter(|t| t.axes != [0, 2]) {
-        let axes = [term.axes[0], term.axes[1]];
-        let [su, sv] = [spline.strain_scale[axes[0] as usize], spline.strain_scale[axes[1] as usize]];
-        let grid_term = grid.terms.iter().find(|t| t.axes == axes).expect("sampled term");
-        let (u_lo, u_hi) = (grid_term.values[0][0], *grid_term.values[0].last().expect("values"));
-        let (v_lo, v_hi) = (grid_term.values[1][0], *grid_term.values[1].last().expect("values"));
-        let on_plane = |u: f64, v: f64| material.energy_at(&strain_along(&axes, &[u, v]));
-        let (u_line, v_line) =
-            (linspace(1.5 * u_lo, 1.5 * u_hi, 3001), linspace(1.5 * v_lo, 1.5 * v_hi, 3001));
-        let plane: Vec<f64> = u_line
-            .iter()
-            .step_by(75)
-            .flat_map(|&u| v_line.iter().step_by(75).map(move |&v| (u, v)))
-            .map(|(u, v)| on_plane(u, v))
-            .collect();
-        let tol = 1e-6 * value_range(&plane);
-        let name = format!("{},{}", AXIS_NAMES[axes[0] as usize], AXIS_NAMES[axes[1] as usize]);
-        for v in term.v_knots.iter().map(|k| k * sv) {
-            let ys: Vec<f64> = u_line.iter().map(|&u| on_plane(u, v)).collect();
-            if let Some(i) = unimodality_violation(&ys, tol) {
-                failures
-                    .push(format!("{name}: along the line v = {v}, a second minimum near u = {}", u_line[i]));
-            }
-        }
-        for u in term.u_knots.iter().map(|k| k * su) {
-            let ys: Vec<f64> = v_line.iter().map(|&v| on_plane(u, v)).collect();
-            if let Some(i) = unimodality_violation(&ys, tol) {
-                failures
-                    .push(format!("{name}: along the line u = {u}, a second minimum near v = {}", v_line[i]));
-            }
-        }
-    }
-    failures
+    term_shapes(grid, spline, 1e-6)
+        .into_iter()
+        .filter(|shape| shape.term.contains(','))
+        .flat_map(|shape| shape.violations.into_iter().map(move |v| format!("{}: {v}", shape.term)))
+        .collect()
 }
 
 /// `f_sa(x) = f_sa(-x)` and `Ψ(sa = x) = Ψ(sa = -x)` to 1e-9 relative, and the 2D terms with

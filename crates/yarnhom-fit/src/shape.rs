@@ -1,0 +1,123 @@
+//! Checks of a fitted material's shape: each quasiconvexified term has a single minimum
+//! (A.36). For a 1D term the fitted energy along its axis, for a marched 2D term the fitted
+//! energy on its plane (`f0 + f_u + f_v + f_uv`, the regularized `f*` of A.3.6 the marching acts
+//! on) along every line through its control points, over 1.5 times the sampled range.
+
+use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values};
+use yarnhom_artifacts::{Grid, Spline, StrainSample};
+
+use crate::SplineMaterial;
+
+/// Points per line.
+const POINTS: usize = 1501;
+/// The pair not marched (A.3.4): it carries the Poisson effect.
+const POISSON_PAIR: [u8; 2] = [0, 2];
+
+/// The shape check of one term.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TermShape {
+    /// The term's name.
+    pub term: String,
+    /// Lines checked.
+    pub lines: usize,
+    /// Where a line stops being unimodal: `(line, strain)` descriptions.
+    pub violations: Vec<String>,
+}
+
+/// Where `ys` (ordered) stops being unimodal: `None` if it does not rise more than `tol` above
+/// its running minimum before its global minimum, nor fall more than `tol` below its running
+/// maximum after it (plateaus are allowed); else the offending index.
+pub fn unimodality_violation(ys: &[f64], tol: f64) -> Option<usize> {
+    let m = (0..ys.len()).min_by(|&a, &b| ys[a].total_cmp(&ys[b]))?;
+    let mut low = ys[0];
+    for (i, &y) in ys.iter().enumerate().take(m + 1) {
+        if y > low + tol {
+            return Some(i);
+        }
+        low = low.min(y);
+    }
+    let mut high = ys[m];
+    for (i, &y) in ys.iter().enumerate().skip(m) {
+        if y < high - tol {
+            return Some(i);
+        }
+        high = high.max(y);
+    }
+    None
+}
+
+/// `n` values from `a` to `b`.
+fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect()
+}
+
+fn strain_along(axes: &[u8], values: &[f64]) -> StrainSample {
+    let mut v = [0.0; 5];
+    for (&a, &x) in axes.iter().zip(values) {
+        v[a as usize] = x;
+    }
+    strain_from_values(v)
+}
+
+fn value_range(ys: &[f64]) -> f64 {
+    ys.iter().copied().fold(f64::NEG_INFINITY, f64::max) - ys.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+/// The shape check of every quasiconvexified term of `spline` over the ranges of `grid`;
+/// plateaus up to `relative_tolerance` of a term's energy range are allowed.
+pub fn term_shapes(grid: &Grid, spline: &Spline, relative_tolerance: f64) -> Vec<TermShape> {
+    let material = SplineMaterial::from(spline);
+    grid.terms
+        .iter()
+        .filter(|t| t.axes.as_slice() != POISSON_PAIR)
+        .map(|term| {
+            let ranges: Vec<Vec<f64>> =
+                term.values.iter().map(|v| linspace(1.5 * v[0], 1.5 * v[v.len() - 1], POINTS)).collect();
+            let energy = |values: &[f64]| material.energy_at(&strain_along(&term.axes, values));
+            let lines = lines_through_knots(spline, &term.axes, &ranges);
+            let all: Vec<f64> = lines.iter().flat_map(|l| l.iter().map(|p| energy(p))).collect();
+            let tol = relative_tolerance * value_range(&all);
+            let violations = lines
+                .iter()
+                .filter_map(|line| {
+                    let ys: Vec<f64> = line.iter().map(|p| energy(p)).collect();
+                    unimodality_violation(&ys, tol).map(|i| describe(&term.axes, &line[i]))
+                })
+                .collect();
+            TermShape { term: term.name(), lines: lines.len(), violations }
+        })
+        .collect()
+}
+
+/// The lines of a term: its axis for a 1D term; for a 2D term, along `u` at every `v` control
+/// point and along `v` at every `u` control point (points as strain values of the axes).
+fn lines_through_knots(spline: &Spline, axes: &[u8], ranges: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
+    let Some(term) = spline.terms_2d.iter().find(|t| t.axes.as_slice() == axes) else {
+        return vec![ranges[0].iter().map(|&x| vec![x]).collect()];
+    };
+    let scale = |axis: u8| spline.strain_scale[axis as usize];
+    let along_u =
+        term.v_knots.iter().map(|&k| ranges[0].iter().map(|&u| vec![u, k * scale(axes[1])]).collect());
+    let along_v =
+        term.u_knots.iter().map(|&k| ranges[1].iter().map(|&v| vec![k * scale(axes[0]), v]).collect());
+    along_u.chain(along_v).collect()
+}
+
+fn describe(axes: &[u8], point: &[f64]) -> String {
+    let name = |a: u8| AXIS_NAMES.get(a as usize).copied().unwrap_or("?");
+    let parts: Vec<String> = axes.iter().zip(point).map(|(&a, x)| format!("{} = {x:.4}", name(a))).collect();
+    format!("a second minimum near {}", parts.join(", "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unimodality_allows_plateaus_and_finds_second_minima() {
+        assert_eq!(unimodality_violation(&[3.0, 2.0, 2.0, 1.0, 1.0, 4.0], 0.0), None);
+        assert_eq!(unimodality_violation(&[3.0, 1.0, 2.0, 0.5, 4.0], 0.0), Some(2));
+        assert_eq!(unimodality_violation(&[0.0, 2.0, 1.0, 3.0], 0.0), Some(2));
+        assert_eq!(unimodality_violation(&[0.0, 2.0, 1.9, 3.0], 0.2), None);
+    }
+}
