@@ -501,4 +501,25 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
         dir.path(),
     );
     assert!(dir.path().join("s.mcap").exists());
+
+    // The Ch. 6 model (6.1), (6.4) from its JSON file.
+    let ch6 = format!("{}/../../tools/materials/ch6-example.json", env!("CARGO_MANIFEST_DIR"));
+    let report = yarnhom(
+        &[
+            "shell",
+            "simulate",
+            "stretch-x",
+            "--material",
+            &ch6,
+            "-o",
+            "c.mcap",
+            "--frames",
+            "2",
+            "--resolution",
+            "7",
+        ],
+        dir.path(),
+    );
+    assert!(report.status.success(), "{}", stderr(&report));
+    assert!(stderr(&report).contains("elastic energy"), "{}", stderr(&report));
 }
