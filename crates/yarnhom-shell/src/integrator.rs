@@ -77,7 +77,7 @@ pub struct Dynamics {
 pub struct StepStats {
     /// Newton iterations.
     pub newton_iterations: u32,
-    /// Largest free-DOF force imbalance at the end (N).
+    /// Largest free-DOF force imbalance at the last Newton iterate, before its update (N).
     pub residual_n: f64,
     /// Line-search halvings over all iterations.
     pub line_search_steps: u32,
