@@ -201,7 +201,8 @@ fn print_errors(grid: &Grid, spline: &Spline) {
 /// Whether each quasiconvexified term has a single minimum along its lines (A.36).
 fn print_shapes(grid: &Grid, spline: &Spline) {
     println!(
-        "single minimum along every line through the control points, over 1.5x the sampled range (A.36):"
+        "single minimum of the fitted energy on each term's axis or plane, along every line through its \
+         control points, over 1.5x the sampled range (A.36):"
     );
     for shape in term_shapes(grid, spline, 1e-6) {
         match shape.violations.first() {
