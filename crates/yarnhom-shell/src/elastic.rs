@@ -28,6 +28,13 @@ impl Assembly {
         Self { energy: 0.0, gradient: vec![0.0; dofs], triplets: Vec::new() }
     }
 
+    /// Empty it, keeping its memory.
+    pub fn clear(&mut self) {
+        self.energy = 0.0;
+        self.gradient.fill(0.0);
+        self.triplets.clear();
+    }
+
     /// Add an element's energy, gradient and Hessian over the vertices `vertices` (absent
     /// vertices contribute nothing).
     pub fn add_element<const N: usize>(
