@@ -233,7 +233,6 @@ mod tests {
     use super::*;
     use crate::test_support::{
         GridMesh, XorShift, apex_across, assert_all_close, assert_close, fd_jacobian, random_triangle,
-        time_per_call,
     };
     use nalgebra::{Matrix3, Rotation3, SVector, Unit};
 
@@ -500,33 +499,5 @@ mod tests {
             0.01,
             0.01 * c.abs(),
         );
-    }
-
-    /// Release timing: `cargo test --release -- --ignored --nocapture timing`.
-    #[test]
-    #[ignore]
-    fn timing_forms_with_derivatives() {
-        let mut rng = XorShift::new(99);
-        for mask in [0b111, 0b000] {
-            let cases: Vec<_> =
-                (0..64).map(|_| (random_rest(&mut rng), random_stencil(&mut rng, mask))).collect();
-            let mut sink = 0.0;
-            let returned = time_per_call(&cases, 4000, |(rest, stencil)| {
-                let d = forms_with_derivatives(rest, std::hint::black_box(stencil));
-                sink += d.hessian[4][(7, 11)] + d.gradient[(3, 5)];
-            });
-            let mut buffer = FormsWithDerivatives::zeroed();
-            let in_place = time_per_call(&cases, 4000, |(rest, stencil)| {
-                buffer.evaluate(rest, std::hint::black_box(stencil));
-                sink += buffer.hessian[4][(7, 11)] + buffer.gradient[(3, 5)];
-            });
-            let value = time_per_call(&cases, 4000, |(rest, stencil)| {
-                sink += forms(rest, std::hint::black_box(stencil)).1[0];
-            });
-            println!(
-                "neighbours {mask:03b}, µs per stencil (min, median): forms_with_derivatives \
-                 {returned:.2?}, evaluate in place {in_place:.2?}, forms {value:.3?} ({sink:.1})"
-            );
-        }
     }
 }

@@ -121,7 +121,6 @@ mod tests {
     use super::*;
     use crate::test_support::{
         GridMesh, XorShift, assert_all_close, assert_close, fd_gradient, fd_jacobian, random_hinge,
-        time_per_call,
     };
 
     fn hinge_from(q: &SVector<f64, 12>) -> [Vec3; 4] {
@@ -232,19 +231,5 @@ mod tests {
         let (s, c) = (std::f64::consts::PI / 8.0).sin_cos();
         assert_close(k(s, c), 0.5 * (weft + bias), 1e-14); // edge 22.5° off Y
         assert_close(k(c, -s), 0.5 * (bias + warp), 1e-14); // edge 22.5° off X
-    }
-
-    /// Release timing: `cargo test --release -- --ignored --nocapture timing`.
-    #[test]
-    #[ignore]
-    fn timing_hinge_energy_with_derivatives() {
-        let mut rng = XorShift::new(98);
-        let cases: Vec<_> = (0..64).map(|_| (random_rest(&mut rng), random_hinge(&mut rng, 2.0))).collect();
-        let mut sink = 0.0;
-        let timing = time_per_call(&cases, 4000, |(rest, hinge)| {
-            let d = hinge_energy_with_derivatives(rest, std::hint::black_box(hinge));
-            sink += d.hessian[(4, 9)];
-        });
-        println!("hinge_energy_with_derivatives, µs per hinge (min, median): {timing:.3?} ({sink:.1})");
     }
 }

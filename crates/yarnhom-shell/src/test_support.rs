@@ -146,17 +146,3 @@ impl GridMesh {
         far
     }
 }
-
-/// Minimum and median over `batches` of the wall time per call of `f` over all `cases`, in µs.
-/// The minimum filters out preemption and interference from other load on the machine.
-pub fn time_per_call<T>(cases: &[T], batches: usize, mut f: impl FnMut(&T)) -> (f64, f64) {
-    let mut per_call: Vec<f64> = (0..batches)
-        .map(|_| {
-            let start = std::time::Instant::now();
-            cases.iter().for_each(&mut f);
-            start.elapsed().as_secs_f64() * 1e6 / cases.len() as f64
-        })
-        .collect();
-    per_call.sort_by(f64::total_cmp);
-    (per_call[0], per_call[batches / 2])
-}

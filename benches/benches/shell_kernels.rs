@@ -1,0 +1,62 @@
+//! The per-element kernels of the thin-shell simulator, one interior triangle of a curved,
+//! stretched and sheared cloth with the published honeycomb material (`honey1.json`):
+//! - the discrete forms (4.4)-(4.7) with their gradient and Hessian over the 18 stencil DOFs,
+//! - the whole element: forms, the spline material's derivatives and the A.5 composition,
+//! - the eigenvalue clamp of its 18 x 18 Hessian (Sec. 4.2),
+//! - the edge-hinge bending energy (6.4) with derivatives.
+//!
+//! Compared with: no published per-element figure; these are the parts of the per-step time
+//! that stands beside Table 4.2 (`benches/shell.rs`).
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use nalgebra::{Vector2, Vector3};
+use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::elastic::project_psd_18;
+use yarnhom_shell::forms::{RestTriangle, Stencil, forms_with_derivatives};
+use yarnhom_shell::hinge::{HingeRest, hinge_energy_with_derivatives};
+use yarnhom_shell::{ElasticModel, ShellMaterial, ShellMesh};
+
+/// A smooth deformation: stretched, sheared, doubly curved.
+fn deform(m: &Vector2<f64>) -> Vector3<f64> {
+    Vector3::new(1.1 * m.x + 0.05 * m.y, 0.95 * m.y, 15.0 * m.x * m.x - 10.0 * m.y * m.y + 5.0 * m.x * m.y)
+}
+
+fn bench_kernels(c: &mut Criterion) {
+    let path = format!("{}/../../shared/data/hylc-materials/honey1.json", env!("CARGO_MANIFEST_DIR"));
+    let spline = read_spline(std::path::Path::new(&path)).expect("published material");
+    let mesh = ShellMesh::rectangle(0.02, 0.02, 5, 5).expect("mesh");
+    let x: Vec<Vector3<f64>> = mesh.material.iter().map(deform).collect();
+    let t = (0..mesh.triangles.len())
+        .find(|&t| mesh.neighbours[t].iter().all(Option::is_some))
+        .expect("interior");
+    let rest = RestTriangle::new(&mesh.triangles[t].map(|v| mesh.material[v as usize]));
+    let stencil = Stencil {
+        triangle: mesh.triangles[t].map(|v| x[v as usize]),
+        neighbours: mesh.neighbours[t].map(|n| n.map(|v| x[v as usize])),
+    };
+    let model = ElasticModel::new(mesh.clone(), ShellMaterial::spline(SplineMaterial::from(&spline)));
+    let (_, _, hessian) = model.triangle_element_exact(t, &x, true);
+    let hessian = hessian.expect("asked for");
+    let hinge = mesh.hinges[0].vertices;
+    let hinge_rest = HingeRest::new(&hinge.map(|v| mesh.material[v as usize]), 1e-5);
+    let hinge_x = hinge.map(|v| x[v as usize]);
+
+    let mut g = c.benchmark_group("shell kernels");
+    g.bench_function("forms (4.4)-(4.7) with gradient and Hessian, 18 DOFs", |b| {
+        b.iter(|| forms_with_derivatives(&rest, std::hint::black_box(&stencil)))
+    });
+    g.bench_function("spline element: forms, material jet, A.5 composition", |b| {
+        b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), true))
+    });
+    g.bench_function("eigenvalue clamp of an indefinite 18x18 element Hessian", |b| {
+        b.iter(|| project_psd_18(std::hint::black_box(hessian)))
+    });
+    g.bench_function("edge-hinge bending (6.4) with gradient and Hessian", |b| {
+        b.iter(|| hinge_energy_with_derivatives(&hinge_rest, std::hint::black_box(&hinge_x)))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_kernels);
+criterion_main!(benches);
