@@ -30,7 +30,7 @@ pub use error::{Error, Result, ValidationError};
 pub use grid::{Grid, GridSample, GridShard, GridTerm, MergeError};
 pub use pattern::{Fabric, Pattern, RestState, Yarn};
 pub use rvesolve::{RveSolve, StrainSample};
-pub use spline::{BicubicTerm, CubicTerm, FitSettings, Spline, SplineOrigin};
+pub use spline::{AxisLimit, BicubicTerm, CubicTerm, FitSettings, Spline, SplineOrigin};
 pub use yarnmodel::{YarnMechanics, YarnModel};
 
 /// A kind of artifact: a serde type with a name, a schema version, invariants and migrations.

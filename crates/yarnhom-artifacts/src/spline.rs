@@ -105,6 +105,21 @@ pub struct FitSettings {
     pub mls_radius: f64,
     /// Whether the data were symmetrized in `sa` (Sec. 4.3).
     pub symmetrize_shear: bool,
+    /// Strain limits the grid was restricted to before fitting (the thesis chooses sampling
+    /// limits below self-intersection and jamming, App. A.3.1); samples outside were not used.
+    #[serde(default)]
+    pub limits: Vec<AxisLimit>,
+}
+
+/// A closed strain interval of one axis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct AxisLimit {
+    /// The axis, an index into [`AXIS_NAMES`].
+    pub axis: u8,
+    /// Lowest value kept (must be <= 0).
+    pub min: f64,
+    /// Highest value kept (must be >= 0).
+    pub max: f64,
 }
 
 impl Default for FitSettings {
@@ -119,6 +134,7 @@ impl Default for FitSettings {
             min_slope: 0.001,
             mls_radius: 0.12,
             symmetrize_shear: true,
+            limits: Vec::new(),
         }
     }
 }

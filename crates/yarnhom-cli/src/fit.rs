@@ -6,7 +6,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::arcsim::{ArcsimMaterial, read_spline};
-use yarnhom_artifacts::{AnyArtifact, FitSettings, Grid, InputRef, Spline, container};
+use yarnhom_artifacts::grid::AXIS_NAMES;
+use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, InputRef, Spline, container};
+use yarnhom_fit::fit::restrict_grid;
 use yarnhom_fit::{SplineMaterial, fit_errors, fit_grid, term_shapes};
 
 use crate::Outcome;
@@ -69,6 +71,27 @@ pub struct GridFitArgs {
     /// Do not symmetrize the data in `sa`.
     #[arg(long)]
     pub no_shear_symmetry: bool,
+    /// Fit only the samples with an axis within limits, e.g. `--limit kx=-160:160` (repeatable):
+    /// the thesis chooses its sampling limits below self-intersection and jamming (App. A.3.1);
+    /// this applies such limits to a grid sampled wider. The limits must contain 0.
+    #[arg(long = "limit", value_name = "AXIS=MIN:MAX", value_parser = parse_limit)]
+    pub limits: Vec<AxisLimit>,
+}
+
+/// `AXIS=MIN:MAX` with `MIN <= 0 <= MAX`.
+fn parse_limit(text: &str) -> Result<AxisLimit, String> {
+    let (name, range) = text.split_once('=').ok_or("expected AXIS=MIN:MAX, e.g. kx=-160:160")?;
+    let axis = AXIS_NAMES
+        .iter()
+        .position(|&a| a == name)
+        .ok_or_else(|| format!("unknown axis '{name}' (axes: {})", AXIS_NAMES.join(", ")))?;
+    let (min, max) = range.split_once(':').ok_or("expected MIN:MAX after the axis")?;
+    let number = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("'{v}': {e}"));
+    let (min, max) = (number(min)?, number(max)?);
+    if !(min <= 0.0 && max >= 0.0) {
+        return Err(format!("the limits must contain 0 (the rest state), got {min}:{max}"));
+    }
+    Ok(AxisLimit { axis: axis as u8, min, max })
 }
 
 #[derive(Debug, Args)]
@@ -129,6 +152,7 @@ fn settings(args: &GridFitArgs) -> FitSettings {
     s.knots_per_side_2d = args.knots_2d.unwrap_or(s.knots_per_side_2d);
     s.mls_radius = args.mls_radius.unwrap_or(s.mls_radius);
     s.symmetrize_shear = !args.no_shear_symmetry;
+    s.limits = args.limits.clone();
     s
 }
 
@@ -174,8 +198,16 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
         .with_context(|| format!("cannot fit {}", grid_path.display()))?;
     container::write(output, &spline, &provenance("fit", vec![input]))?;
     println!("{}", spline.summary());
-    print_errors(&grid, &spline);
-    print_shapes(&grid, &spline);
+    let fitted = restrict_grid(&grid, &args.limits);
+    if !args.limits.is_empty() {
+        println!(
+            "limits: {} of the grid's {} samples used (the rest lie beyond the limits)",
+            fitted.samples.len(),
+            grid.samples.len()
+        );
+    }
+    print_errors(&fitted, &spline);
+    print_shapes(&fitted, &spline);
     println!("wrote {}", output.display());
     Ok(Outcome::Success)
 }

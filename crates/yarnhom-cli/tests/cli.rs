@@ -419,6 +419,12 @@ fn fit_writes_a_spline_that_reproduces_its_grid_and_plots_it() {
         ok(&["fit", "plot", "synthetic.grid.yh", "synthetic.spline.yh", "-o", "figures"], dir.path());
     assert_eq!(figures.lines().filter(|l| l.ends_with(".svg")).count(), 14, "{figures}");
     fails_with(&["fit", "synthetic.spline.yh", "-o", "x.spline.yh"], dir.path(), "not a grid");
+    let limited =
+        ok(&["fit", "synthetic.grid.yh", "--limit", "kx=-100:150", "-o", "limited.spline.yh"], dir.path());
+    assert!(limited.contains("samples used"), "{limited}");
+    let o = yarnhom(&["fit", "synthetic.grid.yh", "--limit", "kx=10:150", "-o", "x.spline.yh"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("must contain 0"), "{}", stderr(&o));
 }
 
 #[test]

@@ -6,7 +6,7 @@
 
 use yarnhom_artifacts::grid::strain_values;
 use yarnhom_artifacts::{
-    BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
+    AxisLimit, BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
 };
 
 use crate::march::{
@@ -56,8 +56,16 @@ pub enum FitError {
     },
 }
 
-/// Fit a whole grid (Alg. 3). `areal_density_kg_m2` is the cloth's mass per area.
+/// Fit a whole grid (Alg. 3), restricted to the settings' limits ([`restrict_grid`]).
+/// `areal_density_kg_m2` is the cloth's mass per area.
 pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -> Result<Spline, FitError> {
+    let restricted;
+    let grid = if settings.limits.is_empty() {
+        grid
+    } else {
+        restricted = restrict_grid(grid, &settings.limits);
+        &restricted
+    };
     let scale = strain_scale(grid);
     let mut terms_1d = Vec::new();
     let mut terms_2d = Vec::new();
@@ -262,6 +270,65 @@ fn transpose(h: &HermiteGrid, nu: usize, nv: usize) -> HermiteGrid {
     HermiteGrid { values: t(&h.values), du: t(&h.dv), dv: t(&h.du), duv: t(&h.duv) }
 }
 
+/// The grid restricted to the strain limits: each term keeps the axis values within its axes'
+/// limits (0 always stays) and the samples at them, re-indexed. The thesis chooses its sampling
+/// limits below self-intersection and jamming (App. A.3.1); this applies such limits to a grid
+/// sampled wider.
+pub fn restrict_grid(grid: &Grid, limits: &[AxisLimit]) -> Grid {
+    let inside =
+        |axis: u8, v: f64| limits.iter().filter(|l| l.axis == axis).all(|l| v >= l.min && v <= l.max);
+    // Per term and axis: the new index of each old value, or None if it is dropped.
+    let maps: Vec<Vec<Vec<Option<u32>>>> = grid
+        .terms
+        .iter()
+        .map(|term| {
+            term.axes
+                .iter()
+                .zip(&term.values)
+                .map(|(&axis, values)| {
+                    let mut next = 0;
+                    values
+                        .iter()
+                        .map(|&v| {
+                            inside(axis, v).then(|| {
+                                next += 1;
+                                next - 1
+                            })
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect();
+    let terms = grid
+        .terms
+        .iter()
+        .map(|term| GridTerm {
+            axes: term.axes.clone(),
+            values: term
+                .axes
+                .iter()
+                .zip(&term.values)
+                .map(|(&axis, values)| values.iter().copied().filter(|&v| inside(axis, v)).collect())
+                .collect(),
+        })
+        .collect();
+    let samples = grid
+        .samples
+        .iter()
+        .filter_map(|s| {
+            let map = &maps[s.term as usize];
+            let i = map[0][s.index[0] as usize]?;
+            let j = match map.get(1) {
+                Some(m) => m[s.index[1] as usize]?,
+                None => 0,
+            };
+            Some(GridSample { index: [i, j], ..s.clone() })
+        })
+        .collect();
+    Grid { terms, samples, ..grid.clone() }
+}
+
 /// How well a spline reproduces the grid it was fitted to, per term.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TermError {
@@ -321,6 +388,20 @@ fn relative_rms(pairs: &[(f64, f64)], offset: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn restricting_a_grid_keeps_the_samples_within_the_limits() {
+        let grid = crate::synthetic::synthetic_grid();
+        let limits = [AxisLimit { axis: 3, min: -100.0, max: 150.0 }];
+        let restricted = restrict_grid(&grid, &limits);
+        restricted.validate().expect("a valid grid");
+        assert!(restricted.is_complete());
+        assert!(restricted.samples.iter().all(|s| s.strain.kx >= -100.0 && s.strain.kx <= 150.0));
+        let dropped = grid.samples.iter().filter(|s| s.strain.kx < -100.0 || s.strain.kx > 150.0).count();
+        assert!(dropped > 0);
+        assert_eq!(restricted.samples.len() + dropped, grid.samples.len());
+        assert_eq!(restrict_grid(&grid, &[]), grid);
+    }
 
     #[test]
     fn control_points_include_zero_and_span_the_range() {
