@@ -70,7 +70,7 @@ pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -
     let mut terms_1d = Vec::new();
     let mut terms_2d = Vec::new();
     for (t, term) in grid.terms.iter().enumerate() {
-        let data = TermData::gather(grid, t, &scale)?;
+        let data = TermData::gather(grid, t, &scale, settings.mls_radius)?;
         match *term.axes.as_slice() {
             [axis] => terms_1d.push(fit_1d(axis as usize, &data, settings)?),
             [u, v] => terms_2d.push(fit_2d([u as usize, v as usize], &data, settings)?),
@@ -122,7 +122,7 @@ struct TermData {
 }
 
 impl TermData {
-    fn gather(grid: &Grid, t: usize, scale: &[f64; 5]) -> Result<Self, FitError> {
+    fn gather(grid: &Grid, t: usize, scale: &[f64; 5], min_radius: f64) -> Result<Self, FitError> {
         let term = &grid.terms[t];
         let mut strains = vec![Vec::new(); term.axes.len()];
         let mut energies = Vec::new();
@@ -138,7 +138,7 @@ impl TermData {
             return Err(FitError::TooFewSamples { term: term.name(), converged: energies.len() });
         }
         let ranges = normalized_ranges(term, scale);
-        let radius = mls_radius(term, scale);
+        let radius = mls_radius(term, scale, min_radius);
         Ok(Self { name: term.name(), strains, energies, radius, ranges })
     }
 }
@@ -155,14 +155,14 @@ fn normalized_ranges(term: &GridTerm, scale: &[f64; 5]) -> Vec<[f64; 2]> {
 }
 
 /// The larger of the configured radius and [`RADIUS_IN_GAPS`] widest gaps of the term's axes.
-fn mls_radius(term: &GridTerm, scale: &[f64; 5]) -> f64 {
+fn mls_radius(term: &GridTerm, scale: &[f64; 5], min_radius: f64) -> f64 {
     let widest_gap = term
         .axes
         .iter()
         .zip(&term.values)
         .flat_map(|(&axis, values)| values.windows(2).map(move |w| (w[1] - w[0]) / scale[axis as usize]))
         .fold(0.0_f64, f64::max);
-    RADIUS_IN_GAPS * widest_gap
+    (RADIUS_IN_GAPS * widest_gap).max(min_radius)
 }
 
 /// Control points: two linearly spaced ranges left and right of 0 (A.3.2) spanning `span` of
@@ -183,8 +183,7 @@ pub fn control_points(range: [f64; 2], span: f64, per_side: usize) -> Vec<f64> {
 
 /// Alg. 4: one 1D term.
 fn fit_1d(axis: usize, data: &TermData, settings: &FitSettings) -> Result<CubicTerm, FitError> {
-    let mut smoothed =
-        SmoothedEnergy1d::new(&data.strains[0], &data.energies, data.radius.max(settings.mls_radius));
+    let mut smoothed = SmoothedEnergy1d::new(&data.strains[0], &data.energies, data.radius);
     if axis == SHEAR && settings.symmetrize_shear {
         smoothed = smoothed.symmetric();
     }
@@ -250,7 +249,7 @@ fn smoothed_hermite_2d(
     u_knots: &[f64],
     v_knots: &[f64],
 ) -> Option<HermiteGrid> {
-    let radius = data.radius.max(settings.mls_radius);
+    let radius = data.radius;
     let (us, vs) = (&data.strains[0], &data.strains[1]);
     let symmetric = settings.symmetrize_shear;
     if symmetric && axes[1] == SHEAR {
