@@ -222,6 +222,8 @@ impl Simulation {
         // One buffer for every iteration's assembly (about a million Hessian entries on a
         // 2500-vertex cloth), so its memory is allocated once per step.
         let mut a = Assembly::new(3 * x.len());
+        // Φ at the current iterate, when the last line search computed it.
+        let mut phi: Option<f64> = None;
         for iteration in 0..self.dynamics.max_newton_iterations {
             self.assemble(&x, &mut terms, iteration == 0, &mut a);
             self.remove_fixed(&mut a);
@@ -231,7 +233,9 @@ impl Simulation {
                 .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
             self.solver.solve_in_place(&mut dx, 1);
-            let (alpha, halvings) = self.line_search(&x, &dx, &a, &terms);
+            let phi0 = phi.unwrap_or_else(|| self.potential(&x, &terms));
+            let (alpha, halvings, accepted) = self.line_search(&x, phi0, &dx, &a, &terms);
+            phi = accepted;
             stats.line_search_steps += halvings;
             stats.newton_iterations = iteration + 1;
             let mut largest: f64 = 0.0;
@@ -374,8 +378,16 @@ impl Simulation {
     }
 
     /// Backtracking (Armijo) on `Φ` along `dx`: the step length and the number of halvings.
-    fn line_search(&self, x: &[Vector3<f64>], dx: &[f64], a: &Assembly, terms: &StepTerms) -> (f64, u32) {
-        let phi0 = self.potential(x, terms);
+    /// Also returns `Φ` at the accepted point (`None` if no step length was accepted), which
+    /// is the next iteration's `phi0`.
+    fn line_search(
+        &self,
+        x: &[Vector3<f64>],
+        phi0: f64,
+        dx: &[f64],
+        a: &Assembly,
+        terms: &StepTerms,
+    ) -> (f64, u32, Option<f64>) {
         let slope = dot(&a.gradient, dx);
         let mut alpha = 1.0;
         for halvings in 0..30 {
@@ -386,11 +398,11 @@ impl Simulation {
                 .collect();
             let phi = self.potential(&trial, terms);
             if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
-                return (alpha, halvings);
+                return (alpha, halvings, Some(phi));
             }
             alpha *= 0.5;
         }
-        (alpha, 30)
+        (alpha, 30, None)
     }
 }
 
