@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the system packages yarnhom needs on a fresh Debian machine (idempotent, quiet when
-# everything is there): libhdf5 for the HDF5 export, and h5py for the interop test.
+# everything is there): libhdf5 for the HDF5 export; h5py, the official MCAP reader and the rerun
+# CLI (pinned: the rerun crate 0.36 writes what rerun-sdk 0.41 verifies) for the interop tests.
 set -euo pipefail
 
 missing=()
@@ -19,4 +20,16 @@ if ! python3 -c "import h5py, numpy" 2>/dev/null; then
   echo "setup: installing h5py and numpy from PyPI" >&2
   python3 -m pip install --quiet --disable-pip-version-check h5py numpy ||
     echo "setup: warning: h5py could not be installed; the h5py interop test will report SKIPPED" >&2
+fi
+
+if ! python3 -c "import mcap, msgpack, zstandard" 2>/dev/null; then
+  echo "setup: installing the MCAP Python library (mcap, msgpack) from PyPI" >&2
+  python3 -m pip install --quiet --disable-pip-version-check "mcap==1.6.0" msgpack zstandard ||
+    echo "setup: warning: mcap could not be installed; the MCAP interop test will report SKIPPED" >&2
+fi
+
+if ! python3 -m pip show rerun-sdk 2>/dev/null | grep -q '^Version: 0.41.0$'; then
+  echo "setup: installing the rerun CLI (rerun-sdk 0.41.0) from PyPI" >&2
+  python3 -m pip install --quiet --disable-pip-version-check "rerun-sdk==0.41.0" ||
+    echo "setup: warning: rerun-sdk could not be installed; the rerun interop test will report SKIPPED" >&2
 fi

@@ -26,7 +26,8 @@ pub struct Tolerance {
 }
 
 impl Tolerance {
-    fn close(&self, a: f64, b: f64) -> bool {
+    /// Whether `a` is within the tolerance of `b`: `|a - b| <= atol + rtol * |b|`.
+    pub fn close(&self, a: f64, b: f64) -> bool {
         (a - b).abs() <= self.atol + self.rtol * b.abs()
     }
 }
@@ -44,8 +45,89 @@ pub struct FieldDiff {
     pub rms: f64,
     /// Index of the value (row) with the largest difference.
     pub worst_index: usize,
+    /// Where the largest difference is, in the field's own terms (e.g. the strain
+    /// `sx=0.312 sy=-0.050`, or `frame 3, mesh cloth, positions_m[12][2]`), when known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub worst_at: Option<String>,
     /// Values outside the tolerance.
     pub outside: usize,
+}
+
+/// Builds a [`FieldDiff`] from rows of values compared one at a time, so that a comparison
+/// can be streamed. A row's difference is the Euclidean norm of its element differences; a row
+/// is outside tolerance if any element is (or if the rows' lengths differ).
+#[derive(Debug, Clone)]
+pub struct FieldDiffBuilder {
+    diff: FieldDiff,
+    sum_sq: f64,
+}
+
+impl FieldDiffBuilder {
+    /// An empty comparison of `field`.
+    pub fn new(field: impl Into<String>) -> Self {
+        let diff = FieldDiff {
+            field: field.into(),
+            count: 0,
+            max_abs: 0.0,
+            rms: 0.0,
+            worst_index: 0,
+            worst_at: None,
+            outside: 0,
+        };
+        FieldDiffBuilder { diff, sum_sq: 0.0 }
+    }
+
+    /// Compare the next row; returns whether it is the row with the largest difference so far
+    /// (the first row, or a larger or NaN difference), so that the caller can say where it is
+    /// with [`locate_worst`](Self::locate_worst) without describing every row.
+    pub fn push(&mut self, a: &[f64], b: &[f64], tol: Tolerance) -> bool {
+        let sq: f64 = a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum();
+        let norm = sq.sqrt();
+        let index = self.diff.count;
+        self.diff.count += 1;
+        self.sum_sq += sq;
+        if a.len() != b.len() || !a.iter().zip(b).all(|(&x, &y)| tol.close(x, y)) {
+            self.diff.outside += 1;
+        }
+        let worst = index == 0 || norm > self.diff.max_abs || norm.is_nan();
+        if worst {
+            self.diff.max_abs = norm;
+            self.diff.worst_index = index;
+            self.diff.worst_at = None;
+        }
+        worst
+    }
+
+    /// Set where the largest difference is: its index (replacing the row number) and a
+    /// description.
+    pub fn locate_worst(&mut self, index: usize, at: impl Into<String>) {
+        self.diff.worst_index = index;
+        self.diff.worst_at = Some(at.into());
+    }
+
+    /// The comparison so far.
+    pub fn finish(mut self) -> FieldDiff {
+        let n = self.diff.count;
+        self.diff.rms = if n == 0 { 0.0 } else { (self.sum_sq / n as f64).sqrt() };
+        self.diff
+    }
+}
+
+impl FieldDiff {
+    /// The field as one line of a human report: name, count, largest and RMS difference,
+    /// where the largest is, and how many values are outside the tolerance.
+    pub fn report_line(&self) -> String {
+        let at = match &self.worst_at {
+            Some(at) => at.clone(),
+            None => format!("[{}]", self.worst_index),
+        };
+        let outside =
+            if self.outside > 0 { format!("  {} outside tolerance", self.outside) } else { String::new() };
+        format!(
+            "{:<32} n={:<6} max|d|={:.3e} rms={:.3e} worst at {at}{outside}",
+            self.field, self.count, self.max_abs, self.rms
+        )
+    }
 }
 
 /// The difference between two artifacts.
@@ -76,21 +158,14 @@ impl Diff {
         )];
         lines.extend(self.structural.iter().map(|s| format!("  structure: {s}")));
         for f in &self.fields {
-            lines.push(format!(
-                "  {:<32} n={:<6} max|d|={:.3e} rms={:.3e} worst at [{}]{}",
-                f.field,
-                f.count,
-                f.max_abs,
-                f.rms,
-                f.worst_index,
-                if f.outside > 0 { format!("  {} outside tolerance", f.outside) } else { String::new() }
-            ));
+            lines.push(format!("  {}", f.report_line()));
         }
         lines.extend(self.notes.iter().map(|s| format!("  note: {s}")));
         lines.join("\n")
     }
 
-    fn new(kind: &str) -> Self {
+    /// An empty comparison of two artifacts of `kind`.
+    pub fn new(kind: &str) -> Self {
         Diff { kind: kind.into(), structural: vec![], fields: vec![], notes: vec![] }
     }
 
@@ -101,29 +176,11 @@ impl Diff {
             self.structural.push(format!("{field}: {} vs {} entries", a.len(), b.len()));
             return;
         }
-        let mut d = FieldDiff {
-            field: field.into(),
-            count: a.len(),
-            max_abs: 0.0,
-            rms: 0.0,
-            worst_index: 0,
-            outside: 0,
-        };
-        let mut sum_sq = 0.0;
-        for (i, (ra, rb)) in a.iter().zip(b).enumerate() {
-            let sq: f64 = ra.iter().zip(rb).map(|(x, y)| (x - y) * (x - y)).sum();
-            sum_sq += sq;
-            let norm = sq.sqrt();
-            if norm > d.max_abs || norm.is_nan() {
-                d.max_abs = norm;
-                d.worst_index = i;
-            }
-            if !ra.iter().zip(rb).all(|(&x, &y)| tol.close(x, y)) {
-                d.outside += 1;
-            }
+        let mut builder = FieldDiffBuilder::new(field);
+        for (ra, rb) in a.iter().zip(b) {
+            builder.push(ra, rb, tol);
         }
-        d.rms = if a.is_empty() { 0.0 } else { (sum_sq / a.len() as f64).sqrt() };
-        self.fields.push(d);
+        self.fields.push(builder.finish());
     }
 
     fn values(&mut self, field: &str, a: &[f64], b: &[f64], tol: Tolerance) {
@@ -145,11 +202,43 @@ impl Diff {
         let Some(f) = self.fields.last_mut() else { return };
         let Some((worst, _)) = matched.get(f.worst_index) else { return };
         f.worst_index = first.samples.iter().position(|s| s.key() == worst.key()).unwrap_or(f.worst_index);
+        f.worst_at = Some(describe_sample(first, worst));
         if f.outside > 0 {
             let note = format!("{field}: largest difference at {}", worst.describe());
             self.notes.push(note);
         }
     }
+}
+
+/// A strain for reports: the named axes (indices into [`AXIS_NAMES`](crate::grid::AXIS_NAMES))
+/// with their values, e.g. `sx=0.312 sy=-0.05`.
+pub fn describe_strain(values: &[f64; 5], axes: &[usize]) -> String {
+    let number = |x: f64| {
+        if x == 0.0 {
+            "0".to_string()
+        } else if x.abs() >= 0.01 {
+            let text = format!("{x:.4}");
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            format!("{x:.3e}")
+        }
+    };
+    let name = |axis: usize| crate::grid::AXIS_NAMES.get(axis).copied().unwrap_or("?");
+    let parts: Vec<String> = axes
+        .iter()
+        .filter_map(|&axis| Some(format!("{}={}", name(axis), number(*values.get(axis)?))))
+        .collect();
+    parts.join(" ")
+}
+
+/// A grid sample with its term's name and strain, e.g.
+/// `sample (term 3, index [1, 2]) sx,sy at sx=0.1 sy=-0.05`.
+fn describe_sample(grid: &Grid, sample: &GridSample) -> String {
+    let Some(term) = grid.terms.get(sample.term as usize) else { return sample.describe() };
+    let Some(strain) = grid.strain_at(sample.term as usize, sample.index) else { return sample.describe() };
+    let axes: Vec<usize> = term.axes.iter().map(|&a| a as usize).collect();
+    let values = crate::grid::strain_values(&strain);
+    format!("{} {} at {}", sample.describe(), term.name(), describe_strain(&values, &axes))
 }
 
 /// Compare two artifacts.
@@ -358,14 +447,15 @@ fn matched_samples<'a>(a: &'a Grid, b: &'a Grid, d: &mut Diff) -> Vec<(&'a GridS
     let outcome: Vec<_> = pairs.iter().filter(|(x, y)| x.converged != y.converged).map(|p| p.0).collect();
     let stress: Vec<_> =
         pairs.iter().filter(|(x, y)| x.stress.is_some() != y.stress.is_some()).map(|p| p.0).collect();
-    for (what, samples) in [
-        ("only in the first file", only_a),
-        ("only in the second file", only_b),
-        ("converged in one file only", outcome),
-        ("with a stress in one file only", stress),
+    for (what, samples, grid) in [
+        ("only in the first file", only_a, a),
+        ("only in the second file", only_b, b),
+        ("converged in one file only", outcome, a),
+        ("with a stress in one file only", stress, a),
     ] {
-        if let Some(s) = samples.first() {
-            d.structural.push(format!("{} samples {what}, e.g. {}", samples.len(), s.describe()));
+        if !samples.is_empty() {
+            let examples: Vec<String> = samples.iter().take(3).map(|s| describe_sample(grid, s)).collect();
+            d.structural.push(format!("{} samples {what}, e.g. {}", samples.len(), examples.join("; ")));
         }
     }
     pairs

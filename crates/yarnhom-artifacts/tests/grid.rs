@@ -235,6 +235,32 @@ fn missing_samples_and_other_plans_are_structural() {
     assert!(!diff_grids(&a, &c, Tolerance { rtol: 1.0, atol: 1.0 }).equal());
 }
 
+#[test]
+fn samples_in_one_grid_only_are_counted_and_named_by_term_and_strain() {
+    let a = common::sample_grid(None);
+    let mut b = a.clone();
+    let removed: Vec<_> = b.samples.drain(0..2).collect();
+    let d = diff_grids(&b, &a, TIGHT);
+    assert!(!d.equal());
+    let only = d
+        .structural
+        .iter()
+        .find(|s| s.starts_with("2 samples only in the second file, e.g. "))
+        .unwrap_or_else(|| panic!("{:?}", d.structural));
+    for sample in &removed {
+        assert!(only.contains(&sample.describe()), "{only}");
+    }
+    assert!(only.contains("sx at sx=-0.1"), "the strain of the first missing sample: {only}");
+    // The worst sample of a compared field is located by its strain too.
+    let mut c = a.clone();
+    c.samples[8].energy_density_j_m2 = Some(100.0);
+    let d = diff_grids(&a, &c, TIGHT);
+    let energy = d.fields.iter().find(|f| f.field == "samples.energy_density_j_m2").expect("energy");
+    let at = energy.worst_at.as_deref().expect("worst sample located");
+    assert!(at.starts_with(&a.samples[8].describe()) && at.contains('='), "{at}");
+    assert!(d.report().contains(at), "{}", d.report());
+}
+
 #[cfg(feature = "hdf5")]
 mod hdf5 {
     use yarnhom_artifacts::container::{self, Provenance};

@@ -13,10 +13,15 @@ mod inputs;
 mod inspect;
 mod model;
 mod pattern;
+#[cfg(feature = "rerun")]
+mod rerun_cmd;
 mod rve;
 mod sample;
 mod schema;
 mod shell;
+mod trace;
+mod trace_export;
+mod trace_out;
 
 use std::process::ExitCode;
 
@@ -26,7 +31,8 @@ use clap::{Parser, Subcommand};
 ///
 /// Every stage reads and writes versioned, schema-defined artifacts (`NAME.KIND.yh`: a
 /// checksummed, zstd-compressed msgpack container). `yarnhom inspect` tells what a file is,
-/// `yarnhom convert` turns it into JSON, HDF5 or `.pyp`, `yarnhom diff` compares two of them.
+/// `yarnhom convert` turns it into JSON, HDF5 or `.pyp`, `yarnhom diff` compares two of them (or
+/// two MCAP traces).
 #[derive(Debug, Parser)]
 #[command(name = "yarnhom", version, propagate_version = true, max_term_width = 100)]
 struct Cli {
@@ -55,13 +61,22 @@ enum Command {
     /// materials, recorded as MCAP traces.
     #[command(subcommand)]
     Shell(shell::ShellCommand),
+    /// MCAP traces as stream filters: info, select, decimate, merge, export (OBJ, PLY, HDF5).
+    /// Each reads a file or stdin (`-`) and writes a file or stdout (`-`).
+    #[command(subcommand)]
+    Trace(trace::TraceCommand),
+    /// Turn a trace into a rerun recording: `--save FILE.rrd`, or `--stdout` for `| rerun -`.
+    #[cfg(feature = "rerun")]
+    Rerun(rerun_cmd::RerunArgs),
     /// Describe an artifact: kind, schema version, provenance and a human summary.
     Inspect(inspect::InspectArgs),
     /// Convert an artifact between `.yh`, JSON, HDF5 and `.pyp`.
     Convert(convert::ConvertArgs),
     /// Print the JSON Schema of an artifact kind, or write every schema to a folder.
     Schema(schema::SchemaArgs),
-    /// Compare two artifacts of the same kind; exit 0 if equal within tolerance, 1 if different.
+    /// Compare two artifacts of the same kind (spline materials by their energies and stresses
+    /// on a dense strain plan) or two MCAP traces (per topic and frame); exit 0 if equal within
+    /// tolerance, 1 if different, 2 on error (unreadable file, kinds that cannot be compared).
     Diff(diff::DiffArgs),
 }
 
@@ -79,6 +94,9 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Grid(cmd) => grid::run(cmd),
         Command::Fit(args) => fit::run(args),
         Command::Shell(cmd) => shell::run(cmd),
+        Command::Trace(cmd) => trace::run(cmd),
+        #[cfg(feature = "rerun")]
+        Command::Rerun(args) => rerun_cmd::run(args),
         Command::Inspect(args) => inspect::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Schema(args) => schema::run(args),

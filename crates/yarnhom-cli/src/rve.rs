@@ -7,12 +7,14 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, container};
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::{solve_at, stress_at_equilibrium, stress_by_finite_differences};
+use yarnhom_rve::homogenize::{solve_at_observed, stress_at_equilibrium, stress_by_finite_differences};
 use yarnhom_rve::relax::RelaxEvent;
-use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl, StopReason};
+use yarnhom_rve::{Iterate, RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl, StopReason};
+use yarnhom_trace::{SolverIteration, TraceMetadata};
 
 use crate::Outcome;
 use crate::inputs::{self, base_name, provenance};
+use crate::trace_out::{TraceSink, is_stdout, yarn_frame};
 
 #[derive(Debug, Subcommand)]
 pub enum RveCommand {
@@ -92,6 +94,11 @@ pub struct SolveArgs {
     /// with this smallest centreline distance in yarn radii, instead of the step limit of A.2.3.
     #[arg(long, value_name = "MIN_SEPARATION_RADII")]
     pub ccd: Option<f64>,
+    /// Record every Newton iteration into an MCAP trace (`-`: stdout): the tile's yarns
+    /// (`/yarn/frame`, frame = iteration) with energy, residual and step length
+    /// (`/solver/iteration`).
+    #[arg(long, value_name = "TRACE")]
+    pub trace: Option<String>,
     /// Output file (default: PATTERN.rvesolve.yh, PATTERN the input's base name).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -170,14 +177,48 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         model.name,
         args.strain
     );
+    let placement = yarnhom_rve::homogenize::placement(&tile, &strain);
+    let mut trace = match &args.trace {
+        Some(path) => {
+            let metadata = TraceMetadata::new("yarnhom rve solve", env!("CARGO_PKG_VERSION"))
+                .with_entry("pattern", args.pattern.display().to_string())
+                .with_entry("model", &args.model)
+                .with_entry("strain", &args.strain);
+            Some(TraceSink::open(path, &metadata)?)
+        }
+        None => None,
+    };
+    let mut trace_error = None;
+    let mut record = |iterate: &Iterate<'_>| {
+        if let Some(sink) = trace.as_mut().filter(|_| trace_error.is_none()) {
+            let frame = iterate.iteration as u64;
+            let written = sink
+                .write(&SolverIteration {
+                    frame,
+                    time_s: 0.0,
+                    iteration: iterate.iteration as u32,
+                    energy_j: iterate.energy_j,
+                    residual: iterate.gradient_ratio,
+                    step_length: iterate.step_length,
+                })
+                .and_then(|()| sink.write(&yarn_frame(pattern, &tile, &placement, iterate.state, frame)))
+                .and_then(|()| sink.end_frame());
+            trace_error = written.err();
+        }
+    };
     let started = Instant::now();
-    let (report, state) = solve_at(&tile, &strain, None, &options);
+    let (report, state) = solve_at_observed(&tile, &strain, None, &options, &mut record);
     let seconds = started.elapsed().as_secs_f64();
+    if let Some(err) = trace_error {
+        return Err(anyhow::Error::new(err).context("cannot write the trace"));
+    }
+    if let Some(sink) = trace {
+        sink.finish()?;
+    }
     let stress = (report.converged && !args.no_stress).then(|| stress_at_equilibrium(&tile, &strain, &state));
     let stress_fd = (report.converged && args.fd_stress)
         .then(|| stress_by_finite_differences(&tile, &strain, &state))
         .flatten();
-    let placement = yarnhom_rve::homogenize::placement(&tile, &strain);
     let result = RveSolve {
         pattern: pattern.name.clone(),
         model: model.name.clone(),
@@ -201,7 +242,11 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     };
     let output = args.output.unwrap_or_else(|| format!("{}.rvesolve.yh", base_name(&args.pattern)).into());
     container::write(&output, &result, &provenance("rve solve", inputs_list))?;
-    println!("{}", result.summary());
+    if args.trace.as_deref().is_some_and(is_stdout) {
+        eprintln!("{}", result.summary());
+    } else {
+        println!("{}", result.summary());
+    }
     eprintln!("wrote {}", output.display());
     if report.converged {
         Ok(Outcome::Success)

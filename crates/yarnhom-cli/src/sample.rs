@@ -12,16 +12,19 @@ use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::{Deserialize, Serialize};
+use yarnhom_artifacts::Pattern;
 use yarnhom_artifacts::container;
-use yarnhom_artifacts::grid::{Grid, GridSample, GridShard, GridTerm, strain_from_values};
+use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard, GridTerm, strain_from_values};
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
     LineResult, SampleOptions, SampleOutcome, SamplePlan, SampleRanges, SweepLine, sample_lines, shard_lines,
 };
+use yarnhom_trace::{RveSample, TraceError, TraceMetadata};
 
 use crate::Outcome;
 use crate::inputs::{base_name, provenance};
 use crate::rve::{load_pattern_and_model, stop_reason};
+use crate::trace_out::{TraceSink, is_stdout, yarns_in_order};
 
 #[derive(Debug, Args)]
 pub struct SampleArgs {
@@ -49,6 +52,12 @@ pub struct SampleArgs {
     /// Newton iteration limit per solve.
     #[arg(long, default_value_t = 2000)]
     pub max_iterations: usize,
+    /// Also record every sample as it is solved into an MCAP trace (`-`: stdout): one
+    /// `/rve/sample` message each (frame = the sample's number in completion order), plus its
+    /// yarns on `/yarn/frame` with `--geometry`. Samples resumed from a checkpoint are not
+    /// recorded again.
+    #[arg(long, value_name = "TRACE")]
+    pub trace: Option<String>,
     /// Output file (default: PATTERN.grid.yh). The checkpoint is OUTPUT.checkpoint.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -125,7 +134,28 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     };
     let started = Instant::now();
     let failed_write = Mutex::new(None);
+    let trace = match &args.trace {
+        Some(path) => {
+            let metadata = TraceMetadata::new("yarnhom rve sample", env!("CARGO_PKG_VERSION"))
+                .with_entry("pattern", args.pattern.display().to_string())
+                .with_entry("model", &args.model)
+                .with_entry("n1d", args.n1d.to_string())
+                .with_entry("n2d", args.n2d.to_string());
+            Some(TraceSink::open(path, &metadata)?)
+        }
+        None => None,
+    };
+    let trace = Mutex::new((trace, 0u64));
+    let failed_trace = Mutex::new(None);
     let results = sample_lines(&tile, &plan, &todo, &options, &|line: &LineResult| {
+        let mut guard = trace.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let (sink, written) = &mut *guard;
+        if let Some(sink) = sink.as_mut()
+            && let Err(e) = record_line(sink, written, &plan, &pattern, &tile, line)
+        {
+            failed_trace.lock().unwrap_or_else(std::sync::PoisonError::into_inner).get_or_insert(e);
+        }
+        drop(guard);
         let record =
             CheckpointLine { line: line.line, samples: line.samples.iter().map(grid_sample).collect() };
         let mut w = writer.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
@@ -137,6 +167,12 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     bar.finish_and_clear();
     if let Some(e) = failed_write.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
         return Err(e.context(format!("cannot write the checkpoint {}", checkpoint.display())));
+    }
+    if let Some(e) = failed_trace.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
+        return Err(anyhow::Error::new(e).context("cannot write the trace"));
+    }
+    if let (Some(sink), _) = trace.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
+        sink.finish()?;
     }
     let mut samples: Vec<GridSample> = done.into_iter().flat_map(|d| d.samples).collect();
     samples.extend(results.iter().flat_map(|l| l.samples.iter().map(grid_sample)));
@@ -151,15 +187,50 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     container::write(&output, &grid, &provenance("rve sample", inputs))?;
     std::fs::remove_file(&checkpoint).with_context(|| format!("cannot remove {}", checkpoint.display()))?;
     let converged = grid.samples.iter().filter(|s| s.converged).count();
-    println!(
+    let summary = format!(
         "sampled '{}': {converged} of {} samples converged, {:.1} s this run\n{}",
         pattern.name,
         grid.samples.len(),
         started.elapsed().as_secs_f64(),
         grid.summary()
     );
+    if args.trace.as_deref().is_some_and(is_stdout) {
+        eprintln!("{summary}");
+    } else {
+        println!("{summary}");
+    }
     eprintln!("wrote {}", output.display());
     Ok(Outcome::Success)
+}
+
+/// Writes the samples of a finished line to the trace, numbering them on from `written`.
+fn record_line(
+    sink: &mut TraceSink,
+    written: &mut u64,
+    plan: &SamplePlan,
+    pattern: &Pattern,
+    tile: &RveModel,
+    line: &LineResult,
+) -> Result<(), TraceError> {
+    for s in &line.samples {
+        let frame = *written;
+        *written += 1;
+        sink.write(&RveSample {
+            frame,
+            time_s: 0.0,
+            term: plan.terms[s.term].axes.iter().map(|&a| AXIS_NAMES[a]).collect::<Vec<_>>().join(","),
+            grid_index: s.index,
+            strain: s.strain,
+            converged: s.converged,
+            energy_density_j_m2: s.energy_density_j_m2,
+            stress: s.stress,
+            iterations: s.iterations as u32,
+        })?;
+        if let (Some(positions), Some(twists)) = (&s.positions_m, &s.edge_twist_rad) {
+            sink.write(&yarns_in_order(pattern, tile, positions, twists, frame))?;
+        }
+    }
+    sink.end_frame()
 }
 
 /// `K/N` with `0 <= K < N`.

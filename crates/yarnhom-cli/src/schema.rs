@@ -12,8 +12,8 @@ pub struct SchemaArgs {
     /// Artifact kind (pattern, yarnmodel). Omit with --write-all.
     #[arg(required_unless_present = "write_all")]
     pub kind: Option<String>,
-    /// Write the current schema of every kind as DIR/KIND.vN.schema.json (how the
-    /// committed `schemas/` folder is made).
+    /// Write the current schema of every kind as DIR/KIND.vN.schema.json, and of every trace
+    /// topic as DIR/trace/SCHEMA_NAME.schema.json (how the committed `schemas/` folder is made).
     #[arg(long, value_name = "DIR", conflicts_with = "kind")]
     pub write_all: Option<PathBuf>,
 }
@@ -23,6 +23,14 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
         for kind in KINDS {
             let path = dir.join(schema::file_name(kind, schema_version(kind)?));
             let text = serde_json::to_string_pretty(&json_schema(kind)?)? + "\n";
+            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
+            eprintln!("wrote {}", path.display());
+        }
+        let trace_dir = dir.join("trace");
+        std::fs::create_dir_all(&trace_dir)?;
+        for (_, name, schema) in yarnhom_trace::topic_schemas() {
+            let path = trace_dir.join(format!("{name}.schema.json"));
+            let text = serde_json::to_string_pretty(&schema)? + "\n";
             yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
             eprintln!("wrote {}", path.display());
         }

@@ -1,7 +1,7 @@
 //! `yarnhom shell ...`: thin-shell cloth simulation with homogenized or Ch. 6 materials.
 
 use std::collections::BTreeMap;
-use std::io::{Seek, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
@@ -11,9 +11,10 @@ use serde::Deserialize;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::simulate::{FrameReport, run as run_scene};
 use yarnhom_shell::{HingeBending, Scene, ShellMaterial, Simulation, StvkNeoHookean};
-use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceMetadata, TraceWriter};
+use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceMetadata};
 
 use crate::Outcome;
+use crate::trace_out::TraceSink;
 
 #[derive(Debug, Subcommand)]
 pub enum ShellCommand {
@@ -36,7 +37,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     pub material: PathBuf,
     /// Output trace (`.mcap`); `-` writes to stdout.
-    #[arg(short, long)]
+    #[arg(short, long, visible_alias = "trace")]
     pub output: String,
     /// Also write every frame as `frame_NNNN.obj` into this folder.
     #[arg(long)]
@@ -105,24 +106,7 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     let metadata = TraceMetadata::new("yarnhom shell simulate", env!("CARGO_PKG_VERSION"))
         .with_entry("scene", &args.scene)
         .with_entry("material", args.material.display().to_string());
-    if args.output == "-" {
-        record(TraceWriter::to_stdout()?, &scene, material, &args, &metadata)
-    } else {
-        let out = record(TraceWriter::create(&args.output)?, &scene, material, &args, &metadata)?;
-        eprintln!("wrote {}", args.output);
-        Ok(out)
-    }
-}
-
-/// Run the scene, writing each frame to the trace (and OBJ files).
-fn record<W: Write + Seek>(
-    mut trace: TraceWriter<W>,
-    scene: &Scene,
-    material: ShellMaterial,
-    args: &SimulateArgs,
-    metadata: &TraceMetadata,
-) -> anyhow::Result<Outcome> {
-    trace.write_metadata(metadata)?;
+    let mut trace = TraceSink::open(&args.output, &metadata)?;
     let total = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
     let bar = ProgressBar::new(total);
     bar.set_style(
@@ -134,11 +118,12 @@ fn record<W: Write + Seek>(
     }
     let mut newton_total = 0u64;
     let mut steps_total = 0u64;
-    let sim = run_scene(scene, material, args.frames, |report, sim| {
+    let sim = run_scene(&scene, material, args.frames, |report, sim| {
         if report.frame == 0 {
-            trace.write_topology(&topology(sim, &scene.name)).map_err(|e| e.to_string())?;
+            trace.write(&topology(sim, &scene.name)).map_err(|e| e.to_string())?;
         }
         write_frame(&mut trace, report, sim, &scene.name).map_err(|e| e.to_string())?;
+        trace.end_frame().map_err(|e| e.to_string())?;
         if let Some(dir) = &args.obj_dir {
             write_obj(&dir.join(format!("frame_{:04}.obj", report.frame)), sim).map_err(|e| e.to_string())?;
         }
@@ -169,28 +154,23 @@ fn topology(sim: &Simulation, name: &str) -> MeshTopology {
     }
 }
 
-fn write_frame<W: Write + Seek>(
-    trace: &mut TraceWriter<W>,
+fn write_frame(
+    trace: &mut TraceSink,
     report: &FrameReport,
     sim: &Simulation,
     name: &str,
 ) -> Result<(), yarnhom_trace::TraceError> {
     let positions_m = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-    trace.write_frame(&MeshFrame {
-        mesh: name.into(),
-        frame: report.frame,
-        time_s: report.time_s,
-        positions_m,
-    })?;
+    trace.write(&MeshFrame { mesh: name.into(), frame: report.frame, time_s: report.time_s, positions_m })?;
     let values = BTreeMap::from([
         ("elastic_energy_j".to_string(), report.elastic_energy_j),
         ("kinetic_energy_j".to_string(), report.kinetic_energy_j),
         ("gravity_energy_j".to_string(), report.gravity_energy_j),
         ("penetration_m".to_string(), report.penetration_m),
     ]);
-    trace.write_scalars(&Scalars { frame: report.frame, time_s: report.time_s, values })?;
+    trace.write(&Scalars { frame: report.frame, time_s: report.time_s, values })?;
     for s in &report.steps {
-        trace.write_solver_step(&SolverStep {
+        trace.write(&SolverStep {
             frame: report.frame,
             time_s: report.time_s,
             newton_iterations: s.newton_iterations,
@@ -205,16 +185,9 @@ fn write_frame<W: Write + Seek>(
 
 /// One frame as a Wavefront OBJ with material coordinates as texture coordinates.
 fn write_obj(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+    let positions: Vec<[f64; 3]> = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let texcoords: Vec<[f64; 2]> = sim.model.mesh.material.iter().map(|m| [m.x, m.y]).collect();
     let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    for p in &sim.positions {
-        writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
-    }
-    for m in &sim.model.mesh.material {
-        writeln!(out, "vt {} {}", m.x, m.y)?;
-    }
-    for t in &sim.model.mesh.triangles {
-        let [a, b, c] = t.map(|v| v + 1);
-        writeln!(out, "f {a}/{a} {b}/{b} {c}/{c}")?;
-    }
+    yarnhom_trace::export::write_obj(&mut out, &positions, &texcoords, &sim.model.mesh.triangles)?;
     out.flush()
 }

@@ -529,3 +529,176 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
     assert!(report.status.success(), "{}", stderr(&report));
     assert!(stderr(&report).contains("elastic energy"), "{}", stderr(&report));
 }
+
+/// `yarnhom diff A A`: exit 0 and "equal within tolerance"; its `--json` form parses and names
+/// the kind.
+fn diff_with_itself(path: &str, kind: &str, dir: &Path) {
+    let o = yarnhom(&["diff", path, path], dir);
+    assert_eq!(o.status.code(), Some(0), "diff {path} {path}: {}{}", stdout(&o), stderr(&o));
+    assert!(stdout(&o).starts_with(&format!("{kind} equal within tolerance")), "{}", stdout(&o));
+    let json: serde_json::Value =
+        serde_json::from_str(&ok(&["diff", path, path, "--json"], dir)).expect("diff --json is JSON");
+    assert_eq!(json["kind"], kind, "{json}");
+}
+
+const MATERIALS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-materials");
+
+#[test]
+fn diff_of_every_artifact_kind_with_itself_exits_0() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let tiny = format!("{DATA}/stocktiniest.pyp");
+    ok(&["pattern", "import", &format!("{DATA}/stock.pyp"), "-o", "stock.pattern.yh"], d);
+    diff_with_itself("stock.pattern.yh", "pattern", d);
+    ok(&["model", "write", "table4.1:stock-small", "-o", "m.yarnmodel.yh"], d);
+    diff_with_itself("m.yarnmodel.yh", "yarnmodel", d);
+    let model = ["--model", "table4.1:stock-small"];
+    ok(&[&["rve", "solve", &tiny][..], &model, &["--strain", "sx=0.1", "-o", "s.rvesolve.yh"]].concat(), d);
+    diff_with_itself("s.rvesolve.yh", "rvesolve", d);
+    ok(
+        &[&["rve", "sample", &tiny][..], &model, &["--n1d", "5", "--n2d", "3", "-o", "g.grid.yh"]].concat(),
+        d,
+    );
+    diff_with_itself("g.grid.yh", "grid", d);
+    ok(&["fit", "g.grid.yh", "-o", "fit.spline.yh"], d);
+    diff_with_itself("fit.spline.yh", "spline", d);
+    ok(&["fit", "import-arcsim", &format!("{MATERIALS}/satin1.json"), "-o", "satin.spline.yh"], d);
+    diff_with_itself("satin.spline.yh", "spline", d);
+    let simulate = ["shell", "simulate", "drape", "--material", "satin.spline.yh", "--resolution", "7"];
+    ok(&[&simulate[..], &["--frames", "2", "-o", "t.mcap"]].concat(), d);
+    diff_with_itself("t.mcap", "trace", d);
+
+    // The same grid fitted with another quasiconvexity slope: a different material, evaluated.
+    ok(&["fit", "g.grid.yh", "--min-slope", "0.05", "-o", "steep.spline.yh"], d);
+    let o = yarnhom(&["diff", "fit.spline.yh", "steep.spline.yh"], d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let report = stdout(&o);
+    assert!(report.starts_with("spline DIFFERENT"), "{report}");
+    let outside = report.lines().filter(|l| l.ends_with("outside tolerance")).count();
+    assert!(outside > 0 && report.contains(".energy_density_j_m2"), "{report}");
+}
+
+#[test]
+fn diff_of_a_spline_with_an_edited_coefficient_names_its_term() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let published = format!("{MATERIALS}/stock1.json");
+    let mut spline =
+        yarnhom_artifacts::arcsim::read_spline(Path::new(&published)).expect("published material");
+    let term = spline.terms_1d.iter_mut().find(|t| t.axis == 3).expect("kx term");
+    let last = term.values.len() - 1;
+    term.values[last] *= 1.5;
+    let json = yarnhom_artifacts::arcsim::ArcsimMaterial::from_spline(&spline).to_json().expect("json");
+    std::fs::write(d.join("edited.json"), json).expect("write");
+    let o = yarnhom(&["diff", &published, "edited.json"], d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let report = stdout(&o);
+    let line = |field: &str| {
+        let start = format!("  {field} ");
+        report.lines().find(|l| l.starts_with(&start)).unwrap_or_else(|| panic!("no {field} in {report}"))
+    };
+    assert!(line("kx.energy_density_j_m2").contains("worst at kx="), "{report}");
+    assert!(line("kx.energy_density_j_m2").ends_with("outside tolerance"), "{report}");
+    for unrelated in ["sx", "sa", "sy", "ky"] {
+        assert!(!line(&format!("{unrelated}.energy_density_j_m2")).contains("outside"), "{report}");
+    }
+    assert!(report.contains("f_kx.values"), "the coefficient note names the term: {report}");
+
+    let o = yarnhom(&["diff", &published, "edited.json", "--json"], d);
+    assert_eq!(o.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("diff --json is JSON");
+    assert_eq!(json["kind"], "spline");
+    let fields = json["fields"].as_array().expect("fields");
+    let field = |name: &str| fields.iter().find(|f| f["field"] == name).unwrap_or_else(|| panic!("{name}"));
+    let kx = field("kx.energy_density_j_m2");
+    assert!(kx["outside"].as_u64().is_some_and(|n| n > 0), "{kx}");
+    assert!(kx["max_abs"].as_f64().is_some_and(|x| x > 0.0), "{kx}");
+    assert!(kx["worst_at"].as_str().is_some_and(|s| s.starts_with("kx=")), "{kx}");
+    assert_eq!(field("sx.stress")["outside"], 0);
+    for key in ["structural", "notes"] {
+        assert!(json[key].is_array(), "{key} in {json}");
+    }
+    // A tolerance above the change makes them equal.
+    assert_eq!(yarnhom(&["diff", &published, "edited.json", "--atol", "1e3"], d).status.code(), Some(0));
+}
+
+#[test]
+fn diff_of_traces_names_missing_frames_and_truncation() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    ok(&["fit", "import-arcsim", &format!("{MATERIALS}/satin1.json"), "-o", "satin.spline.yh"], d);
+    let simulate = ["shell", "simulate", "drape", "--material", "satin.spline.yh", "--resolution", "7"];
+    ok(&[&simulate[..], &["--frames", "2", "-o", "two.mcap"]].concat(), d);
+    ok(&[&simulate[..], &["--frames", "1", "-o", "one.mcap"]].concat(), d);
+    let o = yarnhom(&["diff", "two.mcap", "one.mcap"], d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let report = stdout(&o);
+    assert!(report.starts_with("trace DIFFERENT"), "{report}");
+    assert!(report.contains("  /mesh/frame: 2 messages matched"), "{report}");
+    assert!(report.contains("only in the first trace: 1 messages, e.g. frame 2, mesh drape"), "{report}");
+
+    let o = yarnhom(&["diff", "two.mcap", "one.mcap", "--json"], d);
+    assert_eq!(o.status.code(), Some(1));
+    let json: serde_json::Value = serde_json::from_str(&stdout(&o)).expect("diff --json is JSON");
+    assert_eq!(json["kind"], "trace");
+    let topics = json["topics"].as_array().expect("topics");
+    let frames = topics.iter().find(|t| t["topic"] == "/mesh/frame").expect("/mesh/frame");
+    assert_eq!(frames["matched"], 2);
+    assert_eq!(frames["only_in_first"]["count"], 1);
+    assert!(
+        frames["fields"].as_array().expect("fields").iter().any(|f| f["field"] == "positions_m"),
+        "{frames}"
+    );
+
+    // A trace cut short is a difference, not an error; a trace detected by its content needs no
+    // `.mcap` name.
+    let bytes = std::fs::read(d.join("two.mcap")).expect("read");
+    std::fs::write(d.join("cut"), &bytes[..bytes.len() * 2 / 3]).expect("write");
+    let o = yarnhom(&["diff", "two.mcap", "cut"], d);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    assert!(stdout(&o).contains("structure: the second trace is truncated or damaged"), "{}", stdout(&o));
+}
+
+#[test]
+fn diff_of_a_missing_file_or_of_other_kinds_exits_2() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let pattern = rib(d);
+    let pattern = pattern.to_str().expect("utf8");
+    fails_with(&["diff", pattern, "does-not-exist.yh"], d, "does-not-exist.yh");
+    fails_with(&["diff", "does-not-exist.mcap", pattern], d, "does-not-exist.mcap");
+    ok(&["model", "write", "table4.1:stock", "-o", "m.yarnmodel.yh"], d);
+    fails_with(&["diff", pattern, "m.yarnmodel.yh"], d, "cannot compare a 'pattern'");
+    std::fs::write(d.join("fake.mcap"), b"not a trace").expect("write");
+    fails_with(&["diff", "fake.mcap", "fake.mcap"], d, "not an MCAP trace");
+    ok(&["fit", "import-arcsim", &format!("{MATERIALS}/satin1.json"), "-o", "satin.spline.yh"], d);
+    ok(
+        &[
+            "shell",
+            "simulate",
+            "drape",
+            "--material",
+            "satin.spline.yh",
+            "--frames",
+            "1",
+            "--resolution",
+            "5",
+            "-o",
+            "t.mcap",
+        ],
+        d,
+    );
+    fails_with(&["diff", "t.mcap", pattern], d, "cannot compare a trace");
+}
+
+#[test]
+fn diff_of_an_old_schema_version_with_itself_and_its_migration_exits_0() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let old = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures/rvesolve.v1.yh");
+    diff_with_itself(old, "rvesolve", d);
+    // The migrated file, written in the current version, equals the old one.
+    ok(&["convert", old, "--to", "yh", "-o", "new.rvesolve.yh"], d);
+    let o = yarnhom(&["diff", old, "new.rvesolve.yh"], d);
+    assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
+}

@@ -11,8 +11,11 @@
 //! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
 //! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
+//! - [`difference`]: two spline materials compared by their energies and stresses on a dense
+//!   strain plan (`yarnhom diff`).
 
 pub mod curvature;
+pub mod difference;
 pub mod fit;
 pub mod hermite;
 pub mod march;
@@ -24,6 +27,7 @@ pub mod residual;
 pub mod shape;
 pub mod synthetic;
 
+pub use difference::diff_spline_materials;
 pub use fit::{FitError, TermError, fit_errors, fit_grid};
 pub use material::{EnergyJet, SplineMaterial};
 pub use shape::{TermShape, term_shapes};

@@ -6,7 +6,7 @@ use yarnhom_geom::{MacroStrain, StrainError};
 use crate::assembly::{RveState, Want, assemble};
 use crate::model::RveModel;
 use crate::placement::Placement;
-use crate::solve::{SolveOptions, SolveReport, constraints, multipliers, solve};
+use crate::solve::{Iterate, SolveOptions, SolveReport, constraints, multipliers, solve_observed};
 
 /// Central-difference steps of the solve-based stress: strain (dimensionless) and curvature (in
 /// units of one over the tile's mean period, so that the step bends the tile by a similar amount).
@@ -25,6 +25,17 @@ pub fn solve_at(
     start: Option<&RveState>,
     options: &SolveOptions,
 ) -> (SolveReport, RveState) {
+    solve_at_observed(model, strain, start, options, &mut |_| {})
+}
+
+/// [`solve_at`], showing every Newton iterate to `observe` (see [`solve_observed`]).
+pub fn solve_at_observed(
+    model: &RveModel,
+    strain: &MacroStrain,
+    start: Option<&RveState>,
+    options: &SolveOptions,
+    observe: &mut dyn FnMut(&Iterate<'_>),
+) -> (SolveReport, RveState) {
     let placement = placement(model, strain);
     let mut state = match start {
         Some(s) => {
@@ -34,7 +45,7 @@ pub fn solve_at(
         }
         None => RveState::affine(model, &placement),
     };
-    let report = solve(model, &placement, &mut state, options);
+    let report = solve_observed(model, &placement, &mut state, options, observe);
     (report, state)
 }
 

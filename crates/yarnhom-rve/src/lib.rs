@@ -33,4 +33,4 @@ pub use assembly::Assembled;
 pub use model::{RveError, RveModel};
 pub use placement::Placement;
 pub use relax::{RelaxError, RelaxMethod, RelaxOptions, RelaxReport, relax};
-pub use solve::{SolveOptions, SolveReport, StepControl, StopReason, solve};
+pub use solve::{Iterate, SolveOptions, SolveReport, StepControl, StopReason, solve, solve_observed};

@@ -158,12 +158,39 @@ fn projected(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
     gradient - c.transpose() * multipliers(c, gradient)
 }
 
+/// One Newton iterate of a tile solve, as handed to the observer of [`solve_observed`].
+#[derive(Debug, Clone, Copy)]
+pub struct Iterate<'a> {
+    /// Iteration number, from 0.
+    pub iteration: usize,
+    /// Tile energy at the iterate (J).
+    pub energy_j: f64,
+    /// Projected gradient over its reference (A.33).
+    pub gradient_ratio: f64,
+    /// Fraction of the Newton step taken from this iterate (0 where the solve stopped).
+    pub step_length: f64,
+    /// The iterate.
+    pub state: &'a RveState,
+}
+
 /// Find the tile's equilibrium from `state` (warm or affine start), updating it in place.
 pub fn solve(
     model: &RveModel,
     placement: &Placement,
     state: &mut RveState,
     options: &SolveOptions,
+) -> SolveReport {
+    solve_observed(model, placement, state, options, &mut |_| {})
+}
+
+/// [`solve`], showing every iterate to `observe`: once per Newton iteration with the step
+/// length taken from it, and once more for the iterate where the solve stopped.
+pub fn solve_observed(
+    model: &RveModel,
+    placement: &Placement,
+    state: &mut RveState,
+    options: &SolveOptions,
+    observe: &mut dyn FnMut(&Iterate<'_>),
 ) -> SolveReport {
     let n = model.dof_count();
     let r = model.radius_m;
@@ -187,102 +214,77 @@ pub fn solve(
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
     let mut current = assemble(model, placement, state, &state.g, Want::Derivatives);
-    let report =
-        |reason: StopReason, iterations: usize, energy: f64, ratio: f64, g: &DVector<f64>, analyses| {
-            SolveReport {
-                converged: reason == StopReason::Converged,
-                reason,
-                iterations,
-                energy_j: energy,
-                energy_density_j_m2: energy / model.area_m2(),
-                gradient_ratio: ratio,
-                constraint_residual: (&c * g - &target).amax(),
-                symbolic_analyses: analyses,
+    let (reason, iterations) = 'solve: {
+        for iteration in 0..options.max_iterations {
+            let ratio = residual(&current.gradient) / first;
+            let feasible = (&c * &state.g - &target).amax() < CONSTRAINT_TOLERANCE * r;
+            if ratio < options.tolerance && feasible {
+                break 'solve (StopReason::Converged, iteration);
             }
-        };
-    for iteration in 0..options.max_iterations {
-        let ratio = residual(&current.gradient) / first;
-        let feasible = (&c * &state.g - &target).amax() < CONSTRAINT_TOLERANCE * r;
-        if ratio < options.tolerance && feasible {
-            return report(
-                StopReason::Converged,
-                iteration,
-                current.energy_j,
-                ratio,
-                &state.g,
-                solver.symbolic_analyses,
-            );
+            let (a0, an) = options.regularization;
+            let t = iteration.min(options.regularization_iterations) as f64
+                / options.regularization_iterations as f64;
+            let scaled_gradient = current.gradient.component_mul(&scale);
+            let mut alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
+            let scaled_hessian: Vec<(usize, usize, f64)> =
+                current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
+            let mut factored = false;
+            for _ in 0..30 {
+                if solver.factor(n, &scaled_hessian, alpha).is_ok() {
+                    factored = true;
+                    break;
+                }
+                alpha = (alpha * 10.0).max(1e-12);
+            }
+            if !factored {
+                break 'solve (StopReason::FactorizationFailed, iteration);
+            }
+            let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
+                .component_mul(&scale);
+            let mut length = match options.step_control {
+                StepControl::StepLimit => {
+                    let largest_move =
+                        (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+                    if largest_move > p * r { p * r / largest_move } else { 1.0 }
+                }
+                StepControl::AdditiveCcd { min_separation_radii } => {
+                    max_collision_free_step(model, placement, state, &step, min_separation_radii * r)
+                }
+            };
+            let mut accepted = None;
+            for _ in 0..12 {
+                let trial = &state.g + &step * length;
+                let e = assemble(model, placement, state, &trial, Want::EnergyGradient).energy_j;
+                if e < current.energy_j {
+                    accepted = Some(trial);
+                    break;
+                }
+                length *= 0.1;
+            }
+            let Some(trial) = accepted else {
+                break 'solve (StopReason::LineSearchFailed, iteration);
+            };
+            let energy_j = current.energy_j;
+            observe(&Iterate { iteration, energy_j, gradient_ratio: ratio, step_length: length, state });
+            state.g = trial;
+            state.update_frames(model, placement);
+            current = assemble(model, placement, state, &state.g, Want::Derivatives);
         }
-        let (a0, an) = options.regularization;
-        let t = iteration.min(options.regularization_iterations) as f64
-            / options.regularization_iterations as f64;
-        let scaled_gradient = current.gradient.component_mul(&scale);
-        let mut alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
-        let scaled_hessian: Vec<(usize, usize, f64)> =
-            current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
-        let mut factored = false;
-        for _ in 0..30 {
-            if solver.factor(n, &scaled_hessian, alpha).is_ok() {
-                factored = true;
-                break;
-            }
-            alpha = (alpha * 10.0).max(1e-12);
-        }
-        if !factored {
-            return report(
-                StopReason::FactorizationFailed,
-                iteration,
-                current.energy_j,
-                ratio,
-                &state.g,
-                solver.symbolic_analyses,
-            );
-        }
-        let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
-            .component_mul(&scale);
-        let mut length = match options.step_control {
-            StepControl::StepLimit => {
-                let largest_move =
-                    (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
-                if largest_move > p * r { p * r / largest_move } else { 1.0 }
-            }
-            StepControl::AdditiveCcd { min_separation_radii } => {
-                max_collision_free_step(model, placement, state, &step, min_separation_radii * r)
-            }
-        };
-        let mut accepted = None;
-        for _ in 0..12 {
-            let trial = &state.g + &step * length;
-            let e = assemble(model, placement, state, &trial, Want::EnergyGradient).energy_j;
-            if e < current.energy_j {
-                accepted = Some(trial);
-                break;
-            }
-            length *= 0.1;
-        }
-        let Some(trial) = accepted else {
-            return report(
-                StopReason::LineSearchFailed,
-                iteration,
-                current.energy_j,
-                ratio,
-                &state.g,
-                solver.symbolic_analyses,
-            );
-        };
-        state.g = trial;
-        state.update_frames(model, placement);
-        current = assemble(model, placement, state, &state.g, Want::Derivatives);
-    }
+        (StopReason::IterationLimit, options.max_iterations)
+    };
     let ratio = residual(&current.gradient) / first;
-    report(
-        StopReason::IterationLimit,
-        options.max_iterations,
-        current.energy_j,
-        ratio,
-        &state.g,
-        solver.symbolic_analyses,
-    )
+    let energy_j = current.energy_j;
+    observe(&Iterate { iteration: iterations, energy_j, gradient_ratio: ratio, step_length: 0.0, state });
+    SolveReport {
+        converged: reason == StopReason::Converged,
+        reason,
+        iterations,
+        energy_j,
+        energy_density_j_m2: energy_j / model.area_m2(),
+        gradient_ratio: ratio,
+        constraint_residual: (&c * &state.g - &target).amax(),
+        symbolic_analyses: solver.symbolic_analyses,
+    }
 }
 
 /// The smallest reference of (A.33): the force norm of a 0.1% stretch of every edge. A tile

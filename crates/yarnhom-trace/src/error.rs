@@ -13,6 +13,11 @@ pub enum TraceError {
     #[error("MCAP error: {0}")]
     Mcap(#[source] mcap::McapError),
 
+    /// The trace ends before its end: the producer was killed, or the file is a partial copy.
+    /// Every message before the cut was read.
+    #[error("{0}")]
+    Truncated(Truncation),
+
     /// A message could not be encoded as MessagePack.
     #[error("failed to encode message for topic {topic}: {source}")]
     Encode {
@@ -98,5 +103,27 @@ impl From<mcap::McapError> for TraceError {
             mcap::McapError::Io(io) => Self::Io(io),
             other => Self::Mcap(other),
         }
+    }
+}
+
+/// Where a truncated trace ended; see [`TraceError::Truncated`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct Truncation {
+    /// Messages read in full.
+    pub messages_recovered: u64,
+    /// Bytes read from the source.
+    pub bytes_read: u64,
+    /// Bytes after the last complete record, which could not be decoded.
+    pub bytes_lost: u64,
+}
+
+impl std::fmt::Display for Truncation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the trace is truncated: {} messages recovered from {} bytes; the last {} bytes (an \
+             incomplete record or chunk) were lost",
+            self.messages_recovered, self.bytes_read, self.bytes_lost
+        )
     }
 }

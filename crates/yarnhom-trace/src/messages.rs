@@ -5,16 +5,26 @@ use std::collections::BTreeMap;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 
-/// Topic names of format slice 1.
+/// Topic names.
 pub mod topics {
     /// Topic of [`MeshTopology`](crate::MeshTopology) messages.
     pub const MESH_TOPOLOGY: &str = "/mesh/topology";
     /// Topic of [`MeshFrame`](crate::MeshFrame) messages.
     pub const MESH_FRAME: &str = "/mesh/frame";
+    /// Topic of [`YarnFrame`](crate::YarnFrame) messages.
+    pub const YARN_FRAME: &str = "/yarn/frame";
+    /// Topic of [`TetTopology`](crate::TetTopology) messages.
+    pub const TET_TOPOLOGY: &str = "/tet/topology";
+    /// Topic of [`TetFrame`](crate::TetFrame) messages.
+    pub const TET_FRAME: &str = "/tet/frame";
     /// Topic of [`Scalars`](crate::Scalars) messages.
     pub const METRICS: &str = "/metrics";
     /// Topic of [`SolverStep`](crate::SolverStep) messages.
     pub const SOLVER: &str = "/solver";
+    /// Topic of [`SolverIteration`](crate::SolverIteration) messages.
+    pub const SOLVER_ITERATION: &str = "/solver/iteration";
+    /// Topic of [`RveSample`](crate::RveSample) messages.
+    pub const RVE_SAMPLE: &str = "/rve/sample";
 }
 
 /// MCAP message encoding of every yarnhom channel (MessagePack maps with named fields).
@@ -53,6 +63,103 @@ pub struct MeshFrame {
     pub positions_m: Vec<[f64; 3]>,
 }
 
+/// The yarn centrelines at one frame: every yarn of a yarn-level state (a periodic tile, a
+/// swatch). Written on `/yarn/frame`; self-contained (no topology message), since yarn-level
+/// states are small and yarns may change between frames.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct YarnFrame {
+    /// Name of the yarn set (e.g. the pattern's name); frames of one set share it.
+    pub yarns: String,
+    /// Index of the state on its producer's clock, counting from 0: the output frame of a
+    /// dynamic simulation, the Newton iteration of a static solve.
+    pub frame: u64,
+    /// Simulated time, in seconds (0 for static solves).
+    pub time_s: f64,
+    /// Centreline vertex positions, in metres, yarn after yarn.
+    pub positions_m: Vec<[f64; 3]>,
+    /// Twist of the edge leaving each vertex towards the next vertex of its yarn, in radians
+    /// (the last vertex of an open yarn has an unused 0); empty if the producer has no twists.
+    pub edge_twist_rad: Vec<f64>,
+    /// Yarn radius at each vertex, in metres.
+    pub radii_m: Vec<f64>,
+    /// The yarns as `[first vertex, vertex count]` ranges of `positions_m`, in order.
+    pub yarn_ranges: Vec<[u32; 2]>,
+}
+
+/// The rest state of a tetrahedral mesh with per-element values (e.g. the fitted `gamma` of
+/// volumetric homogenization). Written once per mesh on `/tet/topology`, before its frames.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct TetTopology {
+    /// Human-readable mesh name.
+    pub name: String,
+    /// Tetrahedra as 0-based vertex indices, positively oriented at rest.
+    pub tets: Vec<[u32; 4]>,
+    /// Rest position of each vertex, in metres.
+    pub rest_positions_m: Vec<[f64; 3]>,
+    /// Per-element values by name (one value per tetrahedron), each in the SI unit its name
+    /// implies.
+    pub element_values: BTreeMap<String, Vec<f64>>,
+}
+
+/// Deformed vertex positions of a tetrahedral mesh at one frame. Written on `/tet/frame`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct TetFrame {
+    /// The mesh these positions belong to: the `name` of its [`TetTopology`].
+    pub mesh: String,
+    /// Output frame number, counting from 0.
+    pub frame: u64,
+    /// Simulated time, in seconds.
+    pub time_s: f64,
+    /// World position of each vertex, in metres, in the vertex order of the topology.
+    pub positions_m: Vec<[f64; 3]>,
+}
+
+/// One iteration of a nonlinear solver (a Newton iteration of a tile solve). Written on
+/// `/solver/iteration`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct SolverIteration {
+    /// Index of the state on its producer's clock (for a static solve: the iteration itself,
+    /// matching the `frame` of the geometry written with it).
+    pub frame: u64,
+    /// Simulated time, in seconds (0 for static solves).
+    pub time_s: f64,
+    /// Iteration number within the solve, counting from 0.
+    pub iteration: u32,
+    /// Total energy at the start of the iteration, in joules.
+    pub energy_j: f64,
+    /// Convergence measure at the start of the iteration, in the solver's own norm (for tile
+    /// solves: the projected gradient relative to the affine start's, A.33).
+    pub residual: f64,
+    /// Fraction of the Newton step taken (0 if the iteration ended the solve).
+    pub step_length: f64,
+}
+
+/// One sample of a homogenized energy sweep (thesis App. A.3.1). Written on `/rve/sample` as
+/// each sample is solved.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct RveSample {
+    /// Sample number in the order the samples were written, counting from 0.
+    pub frame: u64,
+    /// Simulated time: always 0 (samples are static solves).
+    pub time_s: f64,
+    /// Name of the plan term (`sx`, `sx,sa`, ...).
+    pub term: String,
+    /// Index of the sample in its term's axes (the second is 0 for 1D terms).
+    pub grid_index: [u32; 2],
+    /// Imposed strain `(sx, sa, sy, kx, ky)`: stretches and shear cosine dimensionless,
+    /// curvatures in 1/m.
+    pub strain: [f64; 5],
+    /// Whether the equilibrium was found.
+    pub converged: bool,
+    /// Homogenized energy density (3.22), in J/m²; absent when not converged.
+    pub energy_density_j_m2: Option<f64>,
+    /// Homogenized stress dΨ/d(sx, sa, sy, kx, ky) (3.23c): J/m² per unit strain, J/m per unit
+    /// curvature; absent when not converged or not computed.
+    pub stress: Option<[f64; 5]>,
+    /// Newton iterations taken.
+    pub iterations: u32,
+}
+
 /// Named scalar metrics at one frame (energies, constraint errors, ...). Written on `/metrics`.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
 pub struct Scalars {
@@ -82,6 +189,25 @@ pub struct SolverStep {
     pub converged: bool,
     /// Wall-clock time spent on the step, in seconds.
     pub wall_time_s: f64,
+}
+
+/// Schema name and JSON Schema of every topic's message type, in the order of the topic table
+/// (committed under `schemas/trace/<schema name>.schema.json`).
+pub fn topic_schemas() -> Vec<(&'static str, &'static str, schemars::Schema)> {
+    fn entry<T: Topic>() -> (&'static str, &'static str, schemars::Schema) {
+        (T::TOPIC, T::SCHEMA_NAME, T::root_schema())
+    }
+    vec![
+        entry::<MeshTopology>(),
+        entry::<MeshFrame>(),
+        entry::<YarnFrame>(),
+        entry::<TetTopology>(),
+        entry::<TetFrame>(),
+        entry::<Scalars>(),
+        entry::<SolverStep>(),
+        entry::<SolverIteration>(),
+        entry::<RveSample>(),
+    ]
 }
 
 pub(crate) mod sealed {
@@ -124,17 +250,28 @@ macro_rules! topic {
 
 topic!(MeshTopology, topics::MESH_TOPOLOGY, "yarnhom.MeshTopology.v1", 1);
 topic!(MeshFrame, topics::MESH_FRAME, "yarnhom.MeshFrame.v1", 1);
+topic!(YarnFrame, topics::YARN_FRAME, "yarnhom.YarnFrame.v1", 1);
+topic!(TetTopology, topics::TET_TOPOLOGY, "yarnhom.TetTopology.v1", 1);
+topic!(TetFrame, topics::TET_FRAME, "yarnhom.TetFrame.v1", 1);
 topic!(Scalars, topics::METRICS, "yarnhom.Scalars.v1", 1);
 topic!(SolverStep, topics::SOLVER, "yarnhom.SolverStep.v1", 1);
+topic!(SolverIteration, topics::SOLVER_ITERATION, "yarnhom.SolverIteration.v1", 1);
+topic!(RveSample, topics::RVE_SAMPLE, "yarnhom.RveSample.v1", 1);
 
-impl sealed::Sealed for MeshTopology {
-    fn time_s(&self) -> Option<f64> {
-        None
-    }
-    fn frame(&self) -> Option<u64> {
-        None
-    }
+macro_rules! untimed {
+    ($($ty:ty),*) => {$(
+        impl sealed::Sealed for $ty {
+            fn time_s(&self) -> Option<f64> {
+                None
+            }
+            fn frame(&self) -> Option<u64> {
+                None
+            }
+        }
+    )*};
 }
+
+untimed!(MeshTopology, TetTopology);
 
 macro_rules! timed {
     ($($ty:ty),*) => {$(
@@ -149,11 +286,21 @@ macro_rules! timed {
     )*};
 }
 
-timed!(MeshFrame, Scalars, SolverStep);
+timed!(MeshFrame, YarnFrame, TetFrame, Scalars, SolverStep, SolverIteration, RveSample);
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn every_topic_is_listed_once() {
+        let listed = topic_schemas();
+        let mut topics: Vec<&str> = listed.iter().map(|(topic, _, _)| *topic).collect();
+        topics.sort_unstable();
+        topics.dedup();
+        assert_eq!(topics.len(), listed.len());
+        assert_eq!(listed.len(), 9);
+    }
 
     fn check<T: Topic>() {
         assert!(T::TOPIC.starts_with('/'));
@@ -167,8 +314,13 @@ mod tests {
     fn topic_constants_are_consistent() {
         check::<MeshTopology>();
         check::<MeshFrame>();
+        check::<YarnFrame>();
+        check::<TetTopology>();
+        check::<TetFrame>();
         check::<Scalars>();
         check::<SolverStep>();
+        check::<SolverIteration>();
+        check::<RveSample>();
     }
 
     #[test]

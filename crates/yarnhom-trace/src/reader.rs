@@ -4,8 +4,10 @@ use std::io::Read;
 
 use crate::TraceError;
 use crate::messages::{
-    MESSAGE_ENCODING, MeshFrame, MeshTopology, Scalars, SolverStep, TOPIC_VERSION_KEY, Topic, topics,
+    MESSAGE_ENCODING, MeshFrame, MeshTopology, RveSample, Scalars, SolverIteration, SolverStep,
+    TOPIC_VERSION_KEY, TetFrame, TetTopology, Topic, YarnFrame, topics,
 };
+use crate::records::{ReadProgress, RecordReader, TraceRecord};
 
 /// One decoded message of a trace.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,44 +17,54 @@ pub enum TraceMessage {
     Topology(MeshTopology),
     /// A `/mesh/frame` message.
     Frame(MeshFrame),
+    /// A `/yarn/frame` message.
+    Yarns(YarnFrame),
+    /// A `/tet/topology` message.
+    TetTopology(TetTopology),
+    /// A `/tet/frame` message.
+    TetFrame(TetFrame),
     /// A `/metrics` message.
     Scalars(Scalars),
     /// A `/solver` message.
     Solver(SolverStep),
-    /// A message on a topic this crate does not know (e.g. from a newer format slice or
-    /// another producer); its payload is skipped.
+    /// A `/solver/iteration` message.
+    SolverIteration(SolverIteration),
+    /// A `/rve/sample` message.
+    RveSample(RveSample),
+    /// A message on a topic this crate does not know (e.g. from a newer format or another
+    /// producer); its payload is skipped.
     Unknown {
         /// The message's topic.
         topic: String,
     },
 }
 
-/// Streams the messages of a trace, in file order, from any [`Read`] source: a file, standard
-/// input, a pipe or a byte slice. No seeking is needed and memory is bounded by the largest
-/// chunk (or message), not by the trace.
+/// Streams the decoded messages of a trace, in file order, from any [`Read`] source: a file,
+/// standard input, a pipe or a byte slice. No seeking is needed and memory is bounded by the
+/// largest chunk (or message), not by the trace. Metadata records are skipped (see
+/// [`RecordReader`] for them).
 ///
 /// Errors come in two kinds. An error in the MCAP container ([`TraceError::Mcap`],
-/// [`TraceError::Io`]) ends the iteration: it is the last item. An error decoding one message
-/// ([`TraceError::Decode`], [`TraceError::UnsupportedTopicVersion`],
-/// [`TraceError::UnsupportedEncoding`]) concerns that message only, and iteration may go on.
+/// [`TraceError::Io`], [`TraceError::Truncated`] after every message that could be read) ends
+/// the iteration: it is the last item. An error decoding one message ([`TraceError::Decode`],
+/// [`TraceError::UnsupportedTopicVersion`], [`TraceError::UnsupportedEncoding`]) concerns that
+/// message only, and iteration may go on.
 ///
 /// The source is read in pieces sized to the records, so wrapping it in a
-/// [`BufReader`](std::io::BufReader) is not needed. The summary section at the end is read
-/// through without being checked against the data, and the MCAP metadata record is skipped; use
-/// [`read_metadata`](crate::read_metadata) for it.
+/// [`BufReader`](std::io::BufReader) is not needed.
 pub struct TraceReader<R: Read> {
-    messages: mcap::io::MessageReader<R>,
+    records: RecordReader<R>,
 }
 
 impl<R: Read> TraceReader<R> {
     /// Starts reading a trace from `source`.
     pub fn new(source: R) -> Self {
-        Self { messages: mcap::io::MessageReader::new(source) }
+        Self { records: RecordReader::new(source) }
     }
 
-    /// Returns the underlying source.
-    pub fn into_inner(self) -> R {
-        self.messages.into_inner()
+    /// How far the reader got.
+    pub fn progress(&self) -> ReadProgress {
+        self.records.progress()
     }
 }
 
@@ -60,24 +72,31 @@ impl<R: Read> Iterator for TraceReader<R> {
     type Item = Result<TraceMessage, TraceError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        Some(match self.messages.next()? {
-            Ok(message) => decode(&message),
-            Err(err) => Err(err.into()),
-        })
+        loop {
+            return Some(match self.records.next()? {
+                Ok(TraceRecord::Message(message)) => decode(&message),
+                Ok(TraceRecord::Metadata(_)) => continue,
+                Err(err) => Err(err),
+            });
+        }
     }
 }
 
 /// Decodes one MCAP message by its channel's topic.
-fn decode(message: &mcap::Message<'_>) -> Result<TraceMessage, TraceError> {
+pub fn decode(message: &mcap::Message<'_>) -> Result<TraceMessage, TraceError> {
     Ok(match message.channel.topic.as_str() {
         topics::MESH_TOPOLOGY => TraceMessage::Topology(decode_as(message)?),
         topics::MESH_FRAME => TraceMessage::Frame(decode_as(message)?),
+        topics::YARN_FRAME => TraceMessage::Yarns(decode_as(message)?),
+        topics::TET_TOPOLOGY => TraceMessage::TetTopology(decode_as(message)?),
+        topics::TET_FRAME => TraceMessage::TetFrame(decode_as(message)?),
         topics::METRICS => TraceMessage::Scalars(decode_as(message)?),
         topics::SOLVER => TraceMessage::Solver(decode_as(message)?),
+        topics::SOLVER_ITERATION => TraceMessage::SolverIteration(decode_as(message)?),
+        topics::RVE_SAMPLE => TraceMessage::RveSample(decode_as(message)?),
         other => TraceMessage::Unknown { topic: other.to_owned() },
     })
 }
-
 /// Checks the channel's encoding and topic version, then decodes the payload as `T`.
 fn decode_as<T: Topic>(message: &mcap::Message<'_>) -> Result<T, TraceError> {
     let channel = &message.channel;

@@ -1,6 +1,6 @@
 //! Writing traces.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::ffi::OsString;
 use std::fs::{self, File, OpenOptions};
 use std::io::{self, BufWriter, Seek, SeekFrom, Stdout, Write};
@@ -10,9 +10,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use mcap::records::MessageHeader;
 use mcap::write::NoSeek;
 
-use crate::messages::{
-    MESSAGE_ENCODING, MeshFrame, MeshTopology, SCHEMA_ENCODING, Scalars, SolverStep, TOPIC_VERSION_KEY, Topic,
-};
+use crate::messages::{MESSAGE_ENCODING, SCHEMA_ENCODING, TOPIC_VERSION_KEY, Topic};
 use crate::{TraceError, TraceMetadata};
 
 /// Default target size of an uncompressed chunk, in bytes (1 MiB, the MCAP library's default).
@@ -112,6 +110,8 @@ pub struct TraceWriter<W: Write + Seek> {
     /// `Some` until `finish` or `drop` takes it; both consume the writer.
     mcap: Option<mcap::Writer<W>>,
     channels: BTreeMap<&'static str, ChannelState>,
+    /// Output channel of each copied input channel, by (source, input channel id).
+    copied_channels: HashMap<(usize, u16), u16>,
     /// Reused MessagePack buffer.
     buf: Vec<u8>,
     /// Runs on the flushed output once the MCAP is complete (the atomic rename of `create`).
@@ -153,6 +153,7 @@ impl<W: Write + Seek> TraceWriter<W> {
         Ok(Self {
             mcap: Some(options.create(out)?),
             channels: BTreeMap::new(),
+            copied_channels: HashMap::new(),
             buf: Vec::new(),
             on_finish: None,
         })
@@ -165,31 +166,46 @@ impl<W: Write + Seek> TraceWriter<W> {
         }
     }
 
-    /// Writes a mesh's rest state on `/mesh/topology`. Write it before the mesh's frames.
-    pub fn write_topology(&mut self, topology: &MeshTopology) -> Result<(), TraceError> {
-        self.write_topic(topology)
-    }
-
-    /// Writes deformed positions on `/mesh/frame`.
-    pub fn write_frame(&mut self, frame: &MeshFrame) -> Result<(), TraceError> {
-        self.write_topic(frame)
-    }
-
-    /// Writes named scalar metrics on `/metrics`.
-    pub fn write_scalars(&mut self, scalars: &Scalars) -> Result<(), TraceError> {
-        self.write_topic(scalars)
-    }
-
-    /// Writes solver statistics on `/solver`.
-    pub fn write_solver_step(&mut self, step: &SolverStep) -> Result<(), TraceError> {
-        self.write_topic(step)
-    }
-
     /// Writes the `yarnhom` metadata record (producer and free key/values). Usually written
     /// once, first; MCAP closes the current chunk before a metadata record.
     pub fn write_metadata(&mut self, metadata: &TraceMetadata) -> Result<(), TraceError> {
         let record = metadata.to_record()?;
-        self.mcap().write_metadata(&record)?;
+        self.write_metadata_record(&record)
+    }
+
+    /// Copies a metadata record read from another trace (a filter's input).
+    pub fn write_metadata_record(&mut self, record: &mcap::records::Metadata) -> Result<(), TraceError> {
+        self.mcap().write_metadata(record)?;
+        Ok(())
+    }
+
+    /// Copies a message read from another trace (a filter's input) without decoding it, with
+    /// its channel and schema. `source` tells inputs apart when several are copied into one
+    /// trace (`trace merge`), since their channel ids may collide; channels with identical
+    /// content (topic, encoding, metadata, schema) share one output channel.
+    pub fn write_message(&mut self, source: usize, message: &mcap::Message<'_>) -> Result<(), TraceError> {
+        let input = &message.channel;
+        let channel_id = match self.copied_channels.get(&(source, input.id)) {
+            Some(&id) => id,
+            None => {
+                let mcap = self.mcap();
+                let schema_id = match &input.schema {
+                    Some(schema) => mcap.add_schema(&schema.name, &schema.encoding, &schema.data)?,
+                    None => 0,
+                };
+                let id =
+                    mcap.add_channel(schema_id, &input.topic, &input.message_encoding, &input.metadata)?;
+                self.copied_channels.insert((source, input.id), id);
+                id
+            }
+        };
+        let header = MessageHeader {
+            channel_id,
+            sequence: message.sequence,
+            log_time: message.log_time,
+            publish_time: message.publish_time,
+        };
+        self.mcap().write_to_known_channel(&header, &message.data)?;
         Ok(())
     }
 
@@ -236,7 +252,9 @@ impl<W: Write + Seek> TraceWriter<W> {
         }
     }
 
-    fn write_topic<T: Topic>(&mut self, message: &T) -> Result<(), TraceError> {
+    /// Writes a message on its topic (a mesh topology before the mesh's frames, frames,
+    /// metrics, ...; see the crate documentation for the topics).
+    pub fn write<T: Topic>(&mut self, message: &T) -> Result<(), TraceError> {
         let log_time = match message.time_s() {
             Some(time_s) => seconds_to_ns(T::TOPIC, time_s)?,
             None => 0,

@@ -70,14 +70,14 @@ fn write_trace<W: Write + Seek>(writer: &mut TraceWriter<W>) -> Vec<TraceMessage
                 .with_entry("material_file", "cotton.json"),
         )
         .expect("metadata");
-    writer.write_topology(&topology()).expect("topology");
+    writer.write(&topology()).expect("topology");
     written.push(TraceMessage::Topology(topology()));
     for i in 0..FRAMES {
-        writer.write_solver_step(&solver(i)).expect("solver");
+        writer.write(&solver(i)).expect("solver");
         written.push(TraceMessage::Solver(solver(i)));
-        writer.write_frame(&frame(i)).expect("frame");
+        writer.write(&frame(i)).expect("frame");
         written.push(TraceMessage::Frame(frame(i)));
-        writer.write_scalars(&scalars(i)).expect("scalars");
+        writer.write(&scalars(i)).expect("scalars");
         written.push(TraceMessage::Scalars(scalars(i)));
     }
     written
@@ -201,14 +201,17 @@ fn abandoned_stream_is_reported_as_truncated() {
     let mut writer = TraceWriter::non_seeking(sink.clone()).expect("writer");
     write_trace(&mut writer);
     writer.flush().expect("flush");
-    writer.write_frame(&frame(FRAMES)).expect("unflushed frame");
+    writer.write(&frame(FRAMES)).expect("unflushed frame");
     drop(writer);
     let bytes = sink.0.borrow().clone();
     let items: Vec<_> = TraceReader::new(bytes.as_slice()).collect();
     let (last, rest) = items.split_last().expect("items");
     assert!(rest.iter().all(Result::is_ok));
     assert_eq!(rest.len(), 1 + 3 * FRAMES as usize, "every flushed message is readable");
-    assert!(matches!(last, Err(TraceError::Mcap(_))), "a missing end must be an error, got {last:?}");
+    assert!(
+        matches!(last, Err(TraceError::Truncated(_))),
+        "a missing end must be reported as truncation, got {last:?}"
+    );
 }
 
 #[test]
@@ -367,7 +370,7 @@ fn garbage_input_is_an_mcap_error() {
 fn invalid_times_are_refused() {
     let mut writer = TraceWriter::non_seeking(Pipe::default()).expect("writer");
     let err = writer
-        .write_frame(&MeshFrame { mesh: "cloth".into(), frame: 0, time_s: f64::NAN, positions_m: vec![] })
+        .write(&MeshFrame { mesh: "cloth".into(), frame: 0, time_s: f64::NAN, positions_m: vec![] })
         .expect_err("NaN time");
     assert!(matches!(err, TraceError::InvalidTime { topic: "/mesh/frame", .. }), "{err}");
     writer.finish().expect("the writer is still usable");

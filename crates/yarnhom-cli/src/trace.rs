@@ -1,0 +1,222 @@
+//! `yarnhom trace ...`: stream filters over MCAP traces. Each reads a file or standard input
+//! (`-`, the default) and writes a file or standard output (`-`, the default), one chunk at a
+//! time, so they chain with pipes:
+//! `yarnhom shell simulate drape -o - | yarnhom trace decimate --every 4 | yarnhom trace info`.
+
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::ops::Range;
+
+use anyhow::Context;
+use clap::{Args, Subcommand};
+use yarnhom_trace::filter::{self, FilterStats, Selection};
+use yarnhom_trace::{RecordReader, TraceMetadata};
+
+use crate::Outcome;
+use crate::trace_out::{TraceSink, with_writer};
+
+#[derive(Debug, Subcommand)]
+pub enum TraceCommand {
+    /// Summarize a trace: topics with message counts, sizes, frame and time ranges; metadata.
+    Info(InfoArgs),
+    /// Keep the messages of some topics, frames or times. Topologies (messages without a frame)
+    /// are kept whenever their topic is.
+    Select(SelectArgs),
+    /// Keep every N-th frame (frames 0, N, 2N, ...) of every topic, and the topologies.
+    Decimate(DecimateArgs),
+    /// Interleave several traces by time into one.
+    Merge(MergeArgs),
+    /// Export a trace: per-frame OBJ or PLY files (meshes, tet-mesh boundaries, yarn
+    /// polylines) into a folder, or one HDF5 file of fixed-shape arrays for training.
+    Export(crate::trace_export::ExportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// Input trace (`-`: standard input).
+    #[arg(default_value = "-")]
+    pub input: String,
+    /// Print the summary as JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct SelectArgs {
+    /// Input trace (`-`: standard input).
+    #[arg(default_value = "-")]
+    pub input: String,
+    /// Output trace (`-`: standard output).
+    #[arg(short, long, default_value = "-")]
+    pub output: String,
+    /// Topics to keep: a name (`/mesh/frame`) or a prefix ending in `*` (`/mesh/*`); repeat for
+    /// several. Default: every topic.
+    #[arg(long = "topic", value_name = "TOPIC")]
+    pub topics: Vec<String>,
+    /// Frames to keep, `A:B` (A included, B excluded; either may be left out).
+    #[arg(long, value_name = "A:B")]
+    pub frames: Option<String>,
+    /// Simulated times to keep in seconds, `A:B` (A included, B excluded; either may be left out).
+    #[arg(long, value_name = "A:B")]
+    pub time: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct DecimateArgs {
+    /// Input trace (`-`: standard input).
+    #[arg(default_value = "-")]
+    pub input: String,
+    /// Output trace (`-`: standard output).
+    #[arg(short, long, default_value = "-")]
+    pub output: String,
+    /// Keep frames that are multiples of N.
+    #[arg(long, value_name = "N")]
+    pub every: u64,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Input traces (at most one `-` for standard input).
+    #[arg(required = true, num_args = 2..)]
+    pub inputs: Vec<String>,
+    /// Output trace (`-`: standard output).
+    #[arg(short, long, default_value = "-")]
+    pub output: String,
+}
+
+pub fn run(cmd: TraceCommand) -> anyhow::Result<Outcome> {
+    match cmd {
+        TraceCommand::Info(args) => info(args),
+        TraceCommand::Select(args) => {
+            let selection = Selection {
+                topics: args.topics,
+                frames: args
+                    .frames
+                    .as_deref()
+                    .map(|text| parse_range(text, 0, u64::MAX, "--frames"))
+                    .transpose()?,
+                time_s: args
+                    .time
+                    .as_deref()
+                    .map(|text| parse_range(text, 0.0, f64::INFINITY, "--time"))
+                    .transpose()?,
+                every: None,
+            };
+            let command = "trace select";
+            run_filter(&args.input, &args.output, command, &selection)
+        }
+        TraceCommand::Decimate(args) => {
+            anyhow::ensure!(args.every > 0, "--every must be at least 1");
+            let selection = Selection { every: Some(args.every), ..Selection::default() };
+            run_filter(
+                &args.input,
+                &args.output,
+                &format!("trace decimate --every {}", args.every),
+                &selection,
+            )
+        }
+        TraceCommand::Merge(args) => merge(args),
+        TraceCommand::Export(args) => crate::trace_export::run(args),
+    }
+}
+
+/// Opens the bytes of a trace: a file, or standard input for `-`.
+pub fn open_source(path: &str) -> anyhow::Result<Box<dyn Read>> {
+    Ok(if path == "-" {
+        Box::new(std::io::stdin().lock())
+    } else {
+        Box::new(BufReader::new(File::open(path).with_context(|| format!("cannot open the trace {path}"))?))
+    })
+}
+
+/// Opens a trace input's records: a file, or standard input for `-`.
+pub fn open_input(path: &str) -> anyhow::Result<RecordReader<Box<dyn Read>>> {
+    Ok(RecordReader::new(open_source(path)?))
+}
+
+fn info(args: InfoArgs) -> anyhow::Result<Outcome> {
+    let summary =
+        filter::info(open_input(&args.input)?).with_context(|| format!("reading {}", args.input))?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&summary)?);
+    } else {
+        print!("{summary}");
+    }
+    Ok(Outcome::Success)
+}
+
+/// The metadata record a filter adds to its output: what was done to which input.
+fn filter_metadata(command: &str, inputs: &[String]) -> TraceMetadata {
+    TraceMetadata::new(format!("yarnhom {command}"), env!("CARGO_PKG_VERSION"))
+        .with_entry("inputs", inputs.join(" "))
+}
+
+fn run_filter(input: &str, output: &str, command: &str, selection: &Selection) -> anyhow::Result<Outcome> {
+    let reader = open_input(input)?;
+    let mut sink = TraceSink::open(output, &filter_metadata(command, &[input.to_owned()]))?;
+    let stats = with_writer!(&mut sink, w => filter::filter(reader, w, selection))
+        .with_context(|| format!("{command} {input}"))?;
+    sink.finish()?;
+    report(command, &stats, &[input.to_owned()]);
+    Ok(Outcome::Success)
+}
+
+fn merge(args: MergeArgs) -> anyhow::Result<Outcome> {
+    anyhow::ensure!(
+        args.inputs.iter().filter(|i| *i == "-").count() <= 1,
+        "standard input (`-`) can be given once only"
+    );
+    let readers = args.inputs.iter().map(|i| open_input(i)).collect::<anyhow::Result<Vec<_>>>()?;
+    let mut sink = TraceSink::open(&args.output, &filter_metadata("trace merge", &args.inputs))?;
+    let stats = with_writer!(&mut sink, w => filter::merge(readers, w)).context("trace merge")?;
+    sink.finish()?;
+    report("trace merge", &stats, &args.inputs);
+    Ok(Outcome::Success)
+}
+
+/// Tells on stderr what a filter did, with a warning per truncated input.
+fn report(command: &str, stats: &FilterStats, inputs: &[String]) {
+    for (input, truncation) in &stats.truncated_inputs {
+        eprintln!("warning: {}: {truncation}", inputs.get(*input).map_or("?", String::as_str));
+    }
+    eprintln!(
+        "{command}: kept {} of {} messages ({} metadata records copied)",
+        stats.messages_written, stats.messages_read, stats.metadata_records
+    );
+}
+
+/// Parses `A:B` with either end optional into a half-open range.
+fn parse_range<T>(text: &str, lowest: T, highest: T, flag: &str) -> anyhow::Result<Range<T>>
+where
+    T: std::str::FromStr + PartialOrd + Copy,
+{
+    let (a, b) = text
+        .split_once(':')
+        .with_context(|| format!("{flag} {text}: expected A:B (either may be left out, e.g. 10: or :2.5)"))?;
+    let parse = |part: &str, default: T| -> anyhow::Result<T> {
+        if part.trim().is_empty() {
+            return Ok(default);
+        }
+        part.trim().parse().map_err(|_| anyhow::anyhow!("{flag} {text}: '{part}' is not a valid bound"))
+    };
+    let (start, end) = (parse(a, lowest)?, parse(b, highest)?);
+    anyhow::ensure!(start < end, "{flag} {text}: the range is empty (A must be below B)");
+    Ok(start..end)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::parse_range;
+
+    #[test]
+    fn ranges_parse_with_open_ends_and_reject_empty_or_bad_ones() {
+        assert_eq!(parse_range("2:5", 0, u64::MAX, "--frames").ok(), Some(2..5));
+        assert_eq!(parse_range(":5", 0, u64::MAX, "--frames").ok(), Some(0..5));
+        assert_eq!(parse_range("7:", 0, u64::MAX, "--frames").ok(), Some(7..u64::MAX));
+        assert_eq!(parse_range("0.5:1.5", 0.0, f64::INFINITY, "--time").ok(), Some(0.5..1.5));
+        assert!(parse_range("5:5", 0, u64::MAX, "--frames").is_err());
+        assert!(parse_range("5", 0, u64::MAX, "--frames").is_err());
+        assert!(parse_range("a:3", 0, u64::MAX, "--frames").is_err());
+        assert!(parse_range("-1:3", 0, u64::MAX, "--frames").is_err());
+    }
+}
