@@ -11,6 +11,7 @@ mod fit_plot;
 mod grid;
 mod inputs;
 mod inspect;
+mod measure;
 mod model;
 mod pattern;
 #[cfg(feature = "rerun")]
@@ -78,6 +79,10 @@ enum Command {
     /// on a dense strain plan) or two MCAP traces (per topic and frame); exit 0 if equal within
     /// tolerance, 1 if different, 2 on error (unreadable file, kinds that cannot be compared).
     Diff(diff::DiffArgs),
+    /// Measurement sets of real swatches (calibration inputs): import the published
+    /// stitch-by-stitch data, validate and summarize a set.
+    #[command(subcommand)]
+    Measure(measure::MeasureCommand),
 }
 
 /// What a command reports back to `main`.
@@ -101,6 +106,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Convert(args) => convert::run(args),
         Command::Schema(args) => schema::run(args),
         Command::Diff(args) => diff::run(args),
+        Command::Measure(cmd) => measure::run(cmd),
     }
 }
 

@@ -1,0 +1,14 @@
+//! Calibration inputs of yarnhom: measurement sets of real fabric swatches.
+//!
+//! A measurement set is a directory holding `fabric.toml` (what was measured), `stretch.csv`
+//! (uniaxial stretch tests) and optionally `bending.csv` (pear-loop bending tests); see
+//! [`measure`] and `schemas/measurement-set.md`. [`stitch_by_stitch`] (feature `hdf5`) turns the
+//! published stitch-by-stitch HDF5 files into measurement sets.
+
+pub mod measure;
+#[cfg(feature = "hdf5")]
+pub mod stitch_by_stitch;
+
+pub use measure::{
+    BendingPoint, Direction, Fabric, MeasureError, MeasurementSet, Phase, StretchPoint, Swatch, Yarn,
+};
