@@ -28,7 +28,8 @@ if ! python3 -c "import mcap, msgpack, zstandard" 2>/dev/null; then
     echo "setup: warning: mcap could not be installed; the MCAP interop test will report SKIPPED" >&2
 fi
 
-if ! python3 -m pip show rerun-sdk 2>/dev/null | grep -q '^Version: 0.41.0$'; then
+# (sed reads the whole output: `grep -q` would stop early and, under pipefail, fail the check.)
+if [ "$(python3 -m pip show rerun-sdk 2>/dev/null | sed -n 's/^Version: //p')" != "0.41.0" ]; then
   echo "setup: installing the rerun CLI (rerun-sdk 0.41.0) from PyPI" >&2
   python3 -m pip install --quiet --disable-pip-version-check "rerun-sdk==0.41.0" ||
     echo "setup: warning: rerun-sdk could not be installed; the rerun interop test will report SKIPPED" >&2
