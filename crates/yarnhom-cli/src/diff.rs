@@ -1,7 +1,7 @@
 //! `yarnhom diff A B`: two artifacts of the same kind (splines by evaluation, see
 //! `yarnhom_fit::difference`), or two MCAP traces (`yarnhom_trace::diff`).
 
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
@@ -67,7 +67,11 @@ pub fn run(args: DiffArgs) -> anyhow::Result<Outcome> {
         (true, false) => anyhow::bail!("cannot compare a trace ({}) with an artifact", args.a.display()),
         (false, true) => anyhow::bail!("cannot compare an artifact with a trace ({})", args.b.display()),
     };
-    println!("{}", if args.json { json } else { report });
+    // A reader that stopped early (`| head`) does not change the verdict the exit status gives.
+    match writeln!(std::io::stdout().lock(), "{}", if args.json { json } else { report }) {
+        Err(e) if e.kind() != std::io::ErrorKind::BrokenPipe => return Err(e.into()),
+        _ => {}
+    }
     Ok(if equal { Outcome::Success } else { Outcome::Different })
 }
 

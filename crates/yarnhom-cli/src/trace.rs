@@ -4,7 +4,7 @@
 //! `yarnhom shell simulate drape -o - | yarnhom trace decimate --every 4 | yarnhom trace info`.
 
 use std::fs::File;
-use std::io::{BufReader, Read};
+use std::io::{BufReader, Read, Write};
 use std::ops::Range;
 
 use anyhow::Context;
@@ -138,9 +138,9 @@ fn info(args: InfoArgs) -> anyhow::Result<Outcome> {
     let summary =
         filter::info(open_input(&args.input)?).with_context(|| format!("reading {}", args.input))?;
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&summary)?);
+        writeln!(std::io::stdout().lock(), "{}", serde_json::to_string_pretty(&summary)?)?;
     } else {
-        print!("{summary}");
+        write!(std::io::stdout().lock(), "{summary}")?;
     }
     Ok(Outcome::Success)
 }

@@ -135,6 +135,31 @@ fn a_truncated_trace_is_read_up_to_the_cut_with_a_warning() {
 }
 
 #[test]
+fn a_reader_that_stops_early_ends_the_command_quietly() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    std::fs::write(dir.path().join("a.mcap"), drape_trace(dir.path(), "3")).expect("write");
+    std::fs::write(dir.path().join("b.mcap"), drape_trace(dir.path(), "4")).expect("write");
+    for (args, status) in [
+        (&["diff", "a.mcap", "b.mcap"][..], 1),
+        (&["trace", "info", "a.mcap"], 0),
+        (&["trace", "decimate", "a.mcap", "--every", "2"], 0),
+    ] {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_yarnhom"))
+            .args(args)
+            .current_dir(dir.path())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("spawn");
+        drop(child.stdout.take());
+        let output = child.wait_with_output().expect("wait");
+        let err = String::from_utf8_lossy(&output.stderr);
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert_eq!(output.status.code(), Some(status), "{args:?}: {err}");
+    }
+}
+
+#[test]
 fn filters_refuse_bad_arguments_with_exit_2() {
     let dir = tempfile::tempdir().expect("tempdir");
     for (args, problem) in [
