@@ -414,6 +414,23 @@ fn the_rerun_cli_verifies_our_recording() {
         "rerun rrd verify of the stream: {}",
         String::from_utf8_lossy(&verify.stderr)
     );
+
+    // Yarns (line strips with radii) and Newton iterations (scalars) of a traced tile solve.
+    let pattern = format!("{SHARED}/hylc-patterns/stocktiniest.pyp");
+    ok(&["pattern", "import", &pattern, "-o", "tiny.pattern.yh"], dir.path());
+    let solve = ["rve", "solve", "tiny.pattern.yh", "--model", "table4.1:stock-small", "--strain", "sx=0.1"];
+    ok(&[&solve[..], &["--trace", "solve.mcap", "-o", "s.rvesolve.yh"]].concat(), dir.path());
+    ok(&["rerun", "solve.mcap", "--save", "solve.rrd"], dir.path());
+    let verify = Command::new(&rerun)
+        .args(["rrd", "verify", "solve.rrd"])
+        .current_dir(dir.path())
+        .output()
+        .expect("rerun");
+    assert!(
+        verify.status.success(),
+        "rerun rrd verify of yarns: {}",
+        String::from_utf8_lossy(&verify.stderr)
+    );
 }
 
 /// Writes about `bytes` of compressed trace to `out`: frames of 10,000 vertices whose positions
