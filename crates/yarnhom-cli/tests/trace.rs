@@ -143,6 +143,8 @@ fn a_reader_that_stops_early_ends_the_command_quietly() {
         (&["diff", "a.mcap", "b.mcap"][..], 1),
         (&["trace", "info", "a.mcap"], 0),
         (&["trace", "decimate", "a.mcap", "--every", "2"], 0),
+        (&["schema", "pattern"], 0),
+        (&["--help"], 0),
     ] {
         let mut child = Command::new(env!("CARGO_BIN_EXE_yarnhom"))
             .args(args)
