@@ -391,31 +391,14 @@ fn the_rerun_cli_verifies_our_recording() {
     std::fs::write(dir.path().join("drape.mcap"), drape_trace(dir.path(), "3")).expect("write");
     let logged = ok(&["rerun", "drape.mcap", "--save", "drape.rrd"], dir.path());
     assert!(String::from_utf8_lossy(&logged.stderr).contains("logged"));
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify", "drape.rrd"])
-        .current_dir(dir.path())
-        .output()
-        .expect("rerun");
-    let text =
-        format!("{}{}", String::from_utf8_lossy(&verify.stdout), String::from_utf8_lossy(&verify.stderr));
-    assert!(verify.status.success(), "rerun rrd verify: {text}");
-    assert!(text.contains("verified without error"), "{text}");
+    verify_rrd(&rerun, dir.path(), "drape.rrd");
 
     // The same through a pipe: `yarnhom rerun --stdout` is what `| rerun -` reads.
     let trace = std::fs::read(dir.path().join("drape.mcap")).expect("trace");
     let streamed = yarnhom_piped(&["rerun", "--stdout"], dir.path(), &trace);
     assert!(streamed.status.success(), "{}", String::from_utf8_lossy(&streamed.stderr));
     std::fs::write(dir.path().join("streamed.rrd"), &streamed.stdout).expect("write");
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify", "streamed.rrd"])
-        .current_dir(dir.path())
-        .output()
-        .expect("rerun");
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify of the stream: {}",
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    verify_rrd(&rerun, dir.path(), "streamed.rrd");
 
     // Yarns (line strips with radii) and Newton iterations (scalars) of a traced tile solve.
     let pattern = format!("{SHARED}/hylc-patterns/stocktiniest.pyp");
@@ -423,16 +406,16 @@ fn the_rerun_cli_verifies_our_recording() {
     let solve = ["rve", "solve", "tiny.pattern.yh", "--model", "table4.1:stock-small", "--strain", "sx=0.1"];
     ok(&[&solve[..], &["--trace", "solve.mcap", "-o", "s.rvesolve.yh"]].concat(), dir.path());
     ok(&["rerun", "solve.mcap", "--save", "solve.rrd"], dir.path());
-    let verify = Command::new(&rerun)
-        .args(["rrd", "verify", "solve.rrd"])
-        .current_dir(dir.path())
-        .output()
-        .expect("rerun");
-    assert!(
-        verify.status.success(),
-        "rerun rrd verify of yarns: {}",
-        String::from_utf8_lossy(&verify.stderr)
-    );
+    verify_rrd(&rerun, dir.path(), "solve.rrd");
+}
+
+/// `rerun rrd verify FILE` succeeds and says so.
+fn verify_rrd(rerun: &str, dir: &Path, file: &str) {
+    let verify = Command::new(rerun).args(["rrd", "verify", file]).current_dir(dir).output().expect("rerun");
+    let text =
+        format!("{}{}", String::from_utf8_lossy(&verify.stdout), String::from_utf8_lossy(&verify.stderr));
+    assert!(verify.status.success(), "rerun rrd verify {file}: {text}");
+    assert!(text.contains("verified without error"), "{file}: {text}");
 }
 
 /// Writes about `bytes` of compressed trace to `out`: frames of 10,000 vertices whose positions
