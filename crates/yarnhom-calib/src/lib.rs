@@ -8,7 +8,11 @@
 pub mod measure;
 #[cfg(feature = "hdf5")]
 pub mod stitch_by_stitch;
+pub mod swatch;
+pub mod targets;
+pub mod uniform;
 
 pub use measure::{
-    BendingPoint, Direction, Fabric, MeasureError, MeasurementSet, Phase, StretchPoint, Swatch, Yarn,
+    BendingPoint, Direction, Fabric, MeasureError, MeasurementSet, Phase, Specimen, StretchPoint, Swatch,
+    SwatchOverride, Yarn,
 };

@@ -93,7 +93,8 @@ pub enum MeasureError {
 pub type Result<T> = std::result::Result<T, MeasureError>;
 
 /// In-plane direction of a test, relative to the fabric.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Direction {
     /// Along the courses (knits) or the weft (wovens): `weft`.
     Weft,
@@ -129,7 +130,8 @@ impl fmt::Display for Direction {
 }
 
 /// Whether a stretch point was taken while loading or unloading the swatch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Phase {
     /// Stretch increasing: `load`.
     Load,
@@ -178,7 +180,11 @@ pub struct Fabric {
     pub yarn: Vec<Yarn>,
 }
 
-/// `[swatch]`: the tested piece of fabric.
+/// `[swatch]`: the tested piece of fabric, and where its deformation was read.
+///
+/// The top-level keys describe every direction's swatch; a `[swatch.weft]`, `[swatch.bias]` or
+/// `[swatch.warp]` table overrides them for that direction's test (real tests often use a
+/// separate piece per direction). [`Swatch::specimen`] resolves one direction's geometry.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Swatch {
@@ -188,9 +194,70 @@ pub struct Swatch {
     /// Width at rest, in metres (default 0.06).
     #[serde(default = "default_width_m")]
     pub width_m: f64,
+    /// Rest distance between two stretch markers centred on the swatch along the pull, in
+    /// metres; absent: stretch is read between the clamps.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_gauge_m: Option<f64>,
+    /// Rest distance between two compression markers across the swatch at mid-length, in
+    /// metres; absent: compression is read between the free edges.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_gauge_m: Option<f64>,
     /// Mass per unit area, in kg/m², if measured.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub areal_density_kg_m2: Option<f64>,
+    /// Overrides for the weft test's swatch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weft: Option<SwatchOverride>,
+    /// Overrides for the bias test's swatch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bias: Option<SwatchOverride>,
+    /// Overrides for the warp test's swatch.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub warp: Option<SwatchOverride>,
+}
+
+/// `[swatch.<direction>]`: one direction's swatch, where it differs from `[swatch]`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SwatchOverride {
+    /// Free length between the clamps, in metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub length_m: Option<f64>,
+    /// Width, in metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width_m: Option<f64>,
+    /// Stretch marker distance, in metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stretch_gauge_m: Option<f64>,
+    /// Compression marker distance, in metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compression_gauge_m: Option<f64>,
+}
+
+/// One direction's tested swatch, resolved from `[swatch]` and its override.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Specimen {
+    /// Free length between the clamps (m).
+    pub length_m: f64,
+    /// Width (m).
+    pub width_m: f64,
+    /// Stretch marker distance (m); the clamps when absent.
+    pub stretch_gauge_m: Option<f64>,
+    /// Compression marker distance (m); the free edges when absent.
+    pub compression_gauge_m: Option<f64>,
+}
+
+impl fmt::Display for Specimen {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} m long x {} m wide", self.length_m, self.width_m)?;
+        if let Some(g) = self.stretch_gauge_m {
+            write!(f, ", stretch read over {g} m")?;
+        }
+        if let Some(g) = self.compression_gauge_m {
+            write!(f, ", compression read over {g} m")?;
+        }
+        Ok(())
+    }
 }
 
 impl Default for Swatch {
@@ -198,7 +265,34 @@ impl Default for Swatch {
         Swatch {
             length_m: DEFAULT_SWATCH_LENGTH_M,
             width_m: DEFAULT_SWATCH_WIDTH_M,
+            stretch_gauge_m: None,
+            compression_gauge_m: None,
             areal_density_kg_m2: None,
+            weft: None,
+            bias: None,
+            warp: None,
+        }
+    }
+}
+
+impl Swatch {
+    /// The override table of `direction`, if any.
+    pub fn override_for(&self, direction: Direction) -> Option<&SwatchOverride> {
+        match direction {
+            Direction::Weft => self.weft.as_ref(),
+            Direction::Bias => self.bias.as_ref(),
+            Direction::Warp => self.warp.as_ref(),
+        }
+    }
+
+    /// The swatch tested along `direction`.
+    pub fn specimen(&self, direction: Direction) -> Specimen {
+        let o = self.override_for(direction).cloned().unwrap_or_default();
+        Specimen {
+            length_m: o.length_m.unwrap_or(self.length_m),
+            width_m: o.width_m.unwrap_or(self.width_m),
+            stretch_gauge_m: o.stretch_gauge_m.or(self.stretch_gauge_m),
+            compression_gauge_m: o.compression_gauge_m.or(self.compression_gauge_m),
         }
     }
 }
@@ -300,8 +394,10 @@ impl MeasurementSet {
     /// force ranges, then the bending points per direction.
     pub fn summary(&self) -> String {
         let mut lines = vec![format!("fabric: {} (pattern {})", self.fabric.name, self.fabric.pattern)];
-        let swatch = &self.fabric.swatch;
-        lines.push(format!("swatch: {} m x {} m", swatch.length_m, swatch.width_m));
+        for direction in Direction::ALL.into_iter().filter(|&d| self.stretch.iter().any(|p| p.direction == d))
+        {
+            lines.push(format!("swatch ({direction}): {}", self.fabric.swatch.specimen(direction)));
+        }
         lines.push(format!("stretch points: {}", self.stretch.len()));
         for direction in Direction::ALL {
             for phase in Phase::ALL {
@@ -411,8 +507,19 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
     let mut positive = vec![
         ("swatch.length_m".to_string(), Some(swatch.length_m)),
         ("swatch.width_m".to_string(), Some(swatch.width_m)),
+        ("swatch.stretch_gauge_m".to_string(), swatch.stretch_gauge_m),
+        ("swatch.compression_gauge_m".to_string(), swatch.compression_gauge_m),
         ("swatch.areal_density_kg_m2".to_string(), swatch.areal_density_kg_m2),
     ];
+    for direction in Direction::ALL {
+        if let Some(o) = swatch.override_for(direction) {
+            let key = |k: &str| format!("swatch.{direction}.{k}");
+            positive.push((key("length_m"), o.length_m));
+            positive.push((key("width_m"), o.width_m));
+            positive.push((key("stretch_gauge_m"), o.stretch_gauge_m));
+            positive.push((key("compression_gauge_m"), o.compression_gauge_m));
+        }
+    }
     for (i, yarn) in fabric.yarn.iter().enumerate() {
         positive.push((format!("yarn[{i}].linear_density_tex"), yarn.linear_density_tex));
         positive.push((format!("yarn[{i}].stiffness_n"), yarn.stiffness_n));
@@ -421,6 +528,26 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
     for (field, value) in positive {
         if value.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
             return Err(field_error(field, "must be a finite number > 0"));
+        }
+    }
+    for direction in Direction::ALL {
+        let specimen = swatch.specimen(direction);
+        let prefix = if swatch.override_for(direction).is_some() {
+            format!("swatch.{direction}")
+        } else {
+            "swatch".into()
+        };
+        if specimen.stretch_gauge_m.is_some_and(|g| g > specimen.length_m) {
+            return Err(field_error(
+                format!("{prefix}.stretch_gauge_m"),
+                "must be at most the swatch length",
+            ));
+        }
+        if specimen.compression_gauge_m.is_some_and(|g| g > specimen.width_m) {
+            return Err(field_error(
+                format!("{prefix}.compression_gauge_m"),
+                "must be at most the swatch width",
+            ));
         }
     }
     for (i, yarn) in fabric.yarn.iter().enumerate() {
@@ -663,7 +790,14 @@ mod tests {
             fabric: Fabric {
                 name: "test knit".into(),
                 pattern: "stockinette".into(),
-                swatch: Swatch { length_m: 0.1, width_m: 0.06, areal_density_kg_m2: Some(0.3) },
+                swatch: Swatch {
+                    length_m: 0.1,
+                    width_m: 0.06,
+                    stretch_gauge_m: Some(0.05),
+                    areal_density_kg_m2: Some(0.3),
+                    warp: Some(SwatchOverride { length_m: Some(0.12), ..Default::default() }),
+                    ..Swatch::default()
+                },
                 yarn: vec![Yarn {
                     material: "acrylic".into(),
                     linear_density_tex: Some(50.0),

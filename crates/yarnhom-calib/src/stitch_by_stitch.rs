@@ -30,8 +30,11 @@
 //!   (the acrylic files have none); frame numbers absent from `/videoN/frames` (gaps where the
 //!   tracker had no data) are counted, they were never in the file.
 //! - **Scale.** `/clampSize` pixels are [`CLAMP_SIZE_M`] (35.5 mm). `fabric.toml` gets the
-//!   clamp-to-clamp distance at the first frame of the first video as `swatch.length_m` and
-//!   `/fabricSize` as `swatch.width_m`.
+//!   clamp-to-clamp distance at the first frame of the first video as `swatch.length_m`,
+//!   `/fabricSize` as `swatch.width_m`, and the top/bottom and left/right pin distances of that
+//!   frame as `swatch.stretch_gauge_m` and `swatch.compression_gauge_m` (where the stretch and
+//!   compression were read). [`import_fabric`] merges a fabric's `-x` and `-y` files (separate
+//!   swatches) into one set with per-direction `[swatch.weft]` / `[swatch.warp]` tables.
 //! - **Directions.** Files ending in `-x` are pulled along the courses (`weft`), `-y` along the
 //!   wales (`warp`). The pattern is the file name's middle part (`garter`, `rib`, `seed`,
 //!   `stockinette`), all built-in generators of yarnhom.
@@ -40,7 +43,7 @@ use std::path::{Path, PathBuf};
 
 use ::hdf5::{File, Group};
 
-use crate::measure::{Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch, Yarn};
+use crate::measure::{Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch, SwatchOverride, Yarn};
 
 /// Physical size of `/clampSize` (the clamp's short dimension), in metres.
 pub const CLAMP_SIZE_M: f64 = 0.0355;
@@ -204,13 +207,17 @@ pub fn import(path: &Path, every: usize) -> Result<Import> {
         .copied()
         .filter(|d| d.is_finite() && *d > 0.0)
         .ok_or_else(|| layout(path, "the first frame of the first video has no clamp positions"))?;
+    let stretch_gauge_px = first.length_px.first().copied().filter(|d| d.is_finite() && *d > 0.0);
+    let compression_gauge_px = first.width_px.first().copied().filter(|d| d.is_finite() && *d > 0.0);
     let fabric = Fabric {
         name: file_stem(path).to_string(),
         pattern: pattern.to_string(),
         swatch: Swatch {
             length_m: length_px / scale_px_per_m,
             width_m: fabric_size_px / scale_px_per_m,
-            areal_density_kg_m2: None,
+            stretch_gauge_m: stretch_gauge_px.map(|d| d / scale_px_per_m),
+            compression_gauge_m: compression_gauge_px.map(|d| d / scale_px_per_m),
+            ..Swatch::default()
         },
         yarn: vec![Yarn {
             material: "acrylic".into(),
@@ -227,6 +234,56 @@ pub fn import(path: &Path, every: usize) -> Result<Import> {
         reports.push(report);
     }
     Ok(Import { set: MeasurementSet { fabric, stretch, bending: Vec::new() }, videos: reports })
+}
+
+/// Import the files of one fabric (say its `-x` and `-y` files) into one measurement set: each
+/// file's swatch becomes its direction's `[swatch.<direction>]` override (the first file's is
+/// also the top-level `[swatch]`), and the reports are concatenated in file order. The files
+/// must share a pattern and test distinct directions.
+pub fn import_fabric(paths: &[PathBuf], every: usize) -> Result<Import> {
+    let (first, rest) = paths.split_first().ok_or_else(|| layout(Path::new(""), "no input files"))?;
+    let mut merged = import(first, every)?;
+    let (pattern, direction) = pattern_and_direction(first)?;
+    if rest.is_empty() {
+        return Ok(merged);
+    }
+    merged.set.fabric.name = merged.set.fabric.name.trim_end_matches("-x").trim_end_matches("-y").to_string();
+    let mut directions = vec![direction];
+    let own = merged.set.fabric.swatch.clone();
+    set_override(&mut merged.set.fabric.swatch, direction, &own);
+    for path in rest {
+        let (other_pattern, other_direction) = pattern_and_direction(path)?;
+        if other_pattern != pattern {
+            return Err(layout(
+                path,
+                &format!("pattern '{other_pattern}' differs from '{pattern}' of {}", first.display()),
+            ));
+        }
+        if directions.contains(&other_direction) {
+            return Err(layout(path, &format!("a second file for direction '{other_direction}'")));
+        }
+        directions.push(other_direction);
+        let other = import(path, every)?;
+        set_override(&mut merged.set.fabric.swatch, other_direction, &other.set.fabric.swatch);
+        merged.set.stretch.extend(other.set.stretch);
+        merged.videos.extend(other.videos);
+    }
+    Ok(merged)
+}
+
+/// Record `swatch`'s geometry as `direction`'s override in `target`.
+fn set_override(target: &mut Swatch, direction: Direction, swatch: &Swatch) {
+    let o = Some(SwatchOverride {
+        length_m: Some(swatch.length_m),
+        width_m: Some(swatch.width_m),
+        stretch_gauge_m: swatch.stretch_gauge_m,
+        compression_gauge_m: swatch.compression_gauge_m,
+    });
+    match direction {
+        Direction::Weft => target.weft = o,
+        Direction::Bias => target.bias = o,
+        Direction::Warp => target.warp = o,
+    }
 }
 
 fn file_stem(path: &Path) -> &str {

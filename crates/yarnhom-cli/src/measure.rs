@@ -9,8 +9,8 @@ use crate::Outcome;
 
 #[derive(Debug, Subcommand)]
 pub enum MeasureCommand {
-    /// Convert a stitch-by-stitch HDF5 file (`shared/data/stitch-by-stitch-acrylic/*.h5`) into a
-    /// measurement set: every video as a repeat, load and unload phases separated, saturated
+    /// Convert stitch-by-stitch HDF5 files (`shared/data/stitch-by-stitch-acrylic/*.h5`) of one
+    /// fabric into a measurement set: every video as a repeat, load and unload phases separated, saturated
     /// gauge readings dropped and counted (see `schemas/measurement-set.md`).
     ImportStitchByStitch(ImportArgs),
     /// Read and validate a measurement set; print points per direction and phase with their
@@ -20,8 +20,10 @@ pub enum MeasureCommand {
 
 #[derive(Debug, Args)]
 pub struct ImportArgs {
-    /// The `.h5` file (its name gives the pattern and the direction: `-x` weft, `-y` warp).
-    pub input: PathBuf,
+    /// The `.h5` files of one fabric (each name gives the pattern and the direction: `-x` weft,
+    /// `-y` warp); several files are merged into one set, one swatch per direction.
+    #[arg(required = true)]
+    pub inputs: Vec<PathBuf>,
     /// Output directory (created; fabric.toml and stretch.csv are replaced).
     #[arg(short, long)]
     pub output: PathBuf,
@@ -46,7 +48,7 @@ pub fn run(cmd: MeasureCommand) -> anyhow::Result<Outcome> {
 #[cfg(feature = "hdf5")]
 fn import_stitch_by_stitch(args: ImportArgs) -> anyhow::Result<Outcome> {
     let every = usize::try_from(args.every)?;
-    let imported = yarnhom_calib::stitch_by_stitch::import(&args.input, every)?;
+    let imported = yarnhom_calib::stitch_by_stitch::import_fabric(&args.inputs, every)?;
     imported.set.write(&args.output)?;
     eprintln!("{}", imported.report());
     eprintln!("wrote {} ({} stretch points)", args.output.display(), imported.set.stretch.len());

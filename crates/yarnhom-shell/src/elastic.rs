@@ -35,6 +35,17 @@ impl Assembly {
         self.triplets.clear();
     }
 
+    /// Hold the `fixed` DOFs: zero gradient, identity rows and columns in the Hessian.
+    pub fn pin(&mut self, fixed: &[bool]) {
+        self.triplets.retain(|&(i, j, _)| !fixed[i] && !fixed[j]);
+        for (dof, &f) in fixed.iter().enumerate() {
+            if f {
+                self.gradient[dof] = 0.0;
+                self.triplets.push((dof, dof, 1.0));
+            }
+        }
+    }
+
     /// Add an element's energy, gradient and Hessian over the vertices `vertices` (absent
     /// vertices contribute nothing).
     pub fn add_element<const N: usize>(

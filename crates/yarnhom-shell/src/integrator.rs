@@ -226,7 +226,7 @@ impl Simulation {
         let mut phi: Option<f64> = None;
         for iteration in 0..self.dynamics.max_newton_iterations {
             self.assemble(&x, &mut terms, iteration == 0, &mut a);
-            self.remove_fixed(&mut a);
+            a.pin(&self.fixed);
             stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
             self.solver
                 .factor(3 * x.len(), &a.triplets, 0.0)
@@ -363,18 +363,6 @@ impl Simulation {
             *g += kd / h;
         }
         a.triplets.extend(terms.stiffness_damping.iter().map(|&(i, j, v)| (i, j, v / h)));
-    }
-
-    /// Fixed DOFs: zero gradient, identity rows and columns.
-    fn remove_fixed(&self, a: &mut Assembly) {
-        let fixed = &self.fixed;
-        a.triplets.retain(|&(i, j, _)| !fixed[i] && !fixed[j]);
-        for (dof, &f) in fixed.iter().enumerate() {
-            if f {
-                a.gradient[dof] = 0.0;
-                a.triplets.push((dof, dof, 1.0));
-            }
-        }
     }
 
     /// Backtracking (Armijo) on `Φ` along `dx`: the step length and the number of halvings.

@@ -9,6 +9,7 @@
 //! - [`scene`], [`arcsim_scene`]: scene files, built-ins and the published ARCSim scenes.
 //! - [`simulate`]: running a scene frame by frame.
 //! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping.
+//! - [`statics`]: static equilibrium with held DOFs (clamped swatch tests).
 
 pub mod arcsim_scene;
 pub mod contact;
@@ -21,6 +22,7 @@ pub mod material;
 pub mod mesh;
 pub mod scene;
 pub mod simulate;
+pub mod statics;
 #[cfg(test)]
 mod test_support;
 
