@@ -5,10 +5,13 @@
 //! [`measure`] and `schemas/measurement-set.md`. [`stitch_by_stitch`] (feature `hdf5`) turns the
 //! published stitch-by-stitch HDF5 files into measurement sets.
 
+pub mod lm;
 pub mod measure;
+pub mod shell_fit;
 #[cfg(feature = "hdf5")]
 pub mod stitch_by_stitch;
 pub mod swatch;
+pub mod synth;
 pub mod targets;
 pub mod uniform;
 

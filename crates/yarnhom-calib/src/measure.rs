@@ -15,6 +15,7 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// File name of the fabric description in a measurement set.
@@ -93,7 +94,7 @@ pub enum MeasureError {
 pub type Result<T> = std::result::Result<T, MeasureError>;
 
 /// In-plane direction of a test, relative to the fabric.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Direction {
     /// Along the courses (knits) or the weft (wovens): `weft`.
@@ -130,7 +131,7 @@ impl fmt::Display for Direction {
 }
 
 /// Whether a stretch point was taken while loading or unloading the swatch.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum Phase {
     /// Stretch increasing: `load`.

@@ -31,10 +31,14 @@
 //!   tracker had no data) are counted, they were never in the file.
 //! - **Scale.** `/clampSize` pixels are [`CLAMP_SIZE_M`] (35.5 mm). `fabric.toml` gets the
 //!   clamp-to-clamp distance at the first frame of the first video as `swatch.length_m`,
-//!   `/fabricSize` as `swatch.width_m`, and the top/bottom and left/right pin distances of that
+//!   `/fabricSize` (the width at the clamp) as `swatch.width_m`, and the top/bottom and left/right pin distances of that
 //!   frame as `swatch.stretch_gauge_m` and `swatch.compression_gauge_m` (where the stretch and
 //!   compression were read). [`import_fabric`] merges a fabric's `-x` and `-y` files (separate
 //!   swatches) into one set with per-direction `[swatch.weft]` / `[swatch.warp]` tables.
+//!   Two swatches are wider between their left/right pins than `/fabricSize` at rest (garter
+//!   x: 48.4 mm against 35.2 mm at the clamp; seed y: 150.4 mm against 145.1 mm): the pins sit
+//!   at the free edges of a piece wider in the middle than at the clamps. The set is a
+//!   rectangle, so there `swatch.width_m` is the pin distance (the larger of the two).
 //! - **Directions.** Files ending in `-x` are pulled along the courses (`weft`), `-y` along the
 //!   wales (`warp`). The pattern is the file name's middle part (`garter`, `rib`, `seed`,
 //!   `stockinette`), all built-in generators of yarnhom.
@@ -214,7 +218,7 @@ pub fn import(path: &Path, every: usize) -> Result<Import> {
         pattern: pattern.to_string(),
         swatch: Swatch {
             length_m: length_px / scale_px_per_m,
-            width_m: fabric_size_px / scale_px_per_m,
+            width_m: fabric_size_px.max(compression_gauge_px.unwrap_or(0.0)) / scale_px_per_m,
             stretch_gauge_m: stretch_gauge_px.map(|d| d / scale_px_per_m),
             compression_gauge_m: compression_gauge_px.map(|d| d / scale_px_per_m),
             ..Swatch::default()

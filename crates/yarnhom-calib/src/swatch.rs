@@ -11,6 +11,7 @@
 //! held at 0): the in-plane tests do not involve bending (Sec. 6.3.1).
 
 use nalgebra::{Rotation2, Vector2, Vector3};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_rve::linear::SpdSolver;
 use yarnhom_shell::elastic::{Assembly, ElasticModel};
@@ -22,7 +23,7 @@ use crate::measure::{Direction, Specimen};
 use crate::uniform::direction_angle;
 
 /// A simulated reading of the stretch test.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SimulatedReading {
     /// Stretch between the stretch markers.
     pub stretch: f64,

@@ -9,12 +9,13 @@
 //! The range ends at the largest loading stretch or where the force first reaches a cap
 //! (default 5 N, the top of the thesis' tested range, Sec. 6.2.3), whichever comes first.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 use crate::measure::{Direction, MeasurementSet, Phase, StretchPoint};
 
 /// How the targets are chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct TargetPlan {
     /// Targets per direction.
     pub per_direction: usize,
@@ -31,7 +32,7 @@ impl Default for TargetPlan {
 }
 
 /// One target: a stretch and the measured response there.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Target {
     /// Pull direction.
     pub direction: Direction,

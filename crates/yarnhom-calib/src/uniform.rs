@@ -5,6 +5,7 @@
 //! shell fit.
 
 use nalgebra::Vector2;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_shell::StvkNeoHookean;
 
@@ -26,7 +27,7 @@ pub fn pull_axis(direction: Direction) -> Vector2<f64> {
 }
 
 /// One uniform uniaxial state.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct UniaxialPoint {
     /// Stretch `s` along the pull.
     pub stretch: f64,

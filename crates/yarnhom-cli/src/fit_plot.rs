@@ -36,7 +36,7 @@ const MISSING: RGBColor = RGBColor(0xBB, 0xBB, 0xBB);
 const DATA: RGBColor = RGBColor(0x1F, 0x5F, 0xD0);
 /// The fit (Fig. 4.4: green).
 const FIT: RGBColor = RGBColor(0x1A, 0x9A, 0x3A);
-const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 
 /// Write the figures of `spline` fitted to `grid` into `out_dir` (created if needed): one
 /// `1d-<axis>.svg` per 1D term of the grid (Fig. 4.4) and one `2d-<u>-<v>.svg` per 2D term
@@ -71,20 +71,20 @@ fn axis_label(axis: u8) -> String {
 
 const ENERGY_LABEL: &str = "energy density Ψ [J/m²]";
 
-/// A number for a tick label: short, fixed for moderate magnitudes, else scientific.
-fn format_value(x: f64) -> String {
+/// A number for a tick label: three significant digits without trailing zeros for moderate
+/// magnitudes (so neighbouring ticks 0.005 apart stay distinct), else scientific.
+pub(crate) fn format_value(x: f64) -> String {
     let a = x.abs();
     if a == 0.0 || !a.is_finite() {
         format!("{x}")
     } else if (1e-2..1e4).contains(&a) {
-        let digits = if a >= 100.0 {
-            0
-        } else if a >= 10.0 {
-            1
+        let digits = (2 - a.log10().floor() as i32).clamp(0, 4) as usize;
+        let fixed = format!("{x:.digits$}");
+        if fixed.contains('.') {
+            fixed.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
-            2
-        };
-        format!("{x:.digits$}")
+            fixed
+        }
     } else {
         format!("{x:.1e}")
     }
@@ -123,7 +123,7 @@ fn sampled_range(values: &[f64]) -> (f64, f64) {
 }
 
 /// Render into an SVG string.
-fn render(
+pub(crate) fn render(
     size: (u32, u32),
     draw: impl FnOnce(&DrawingArea<SVGBackend<'_>, Shift>) -> Result<()>,
 ) -> Result<String> {
@@ -137,7 +137,7 @@ fn render(
     Ok(svg)
 }
 
-fn plot_error(e: impl std::fmt::Display) -> anyhow::Error {
+pub(crate) fn plot_error(e: impl std::fmt::Display) -> anyhow::Error {
     anyhow::anyhow!("drawing failed: {e}")
 }
 

@@ -4,6 +4,7 @@
 //! crates together; it holds no numerics. Exit status: 0 success (and "equal" for `diff`),
 //! 1 "different" for `diff`, 2 any error (bad input, unreadable file, usage).
 
+mod calibrate;
 mod convert;
 mod diff;
 mod fit;
@@ -83,6 +84,10 @@ enum Command {
     /// stitch-by-stitch data, validate and summarize a set.
     #[command(subcommand)]
     Measure(measure::MeasureCommand),
+    /// Fit models to a measurement set (thesis Ch. 6): `calibrate shell` fits the (6.1)
+    /// membrane by simulating the clamped swatch tests.
+    #[command(subcommand)]
+    Calibrate(calibrate::CalibrateCommand),
 }
 
 /// What a command reports back to `main`.
@@ -107,6 +112,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Schema(args) => schema::run(args),
         Command::Diff(args) => diff::run(args),
         Command::Measure(cmd) => measure::run(cmd),
+        Command::Calibrate(cmd) => calibrate::run(cmd),
     }
 }
 

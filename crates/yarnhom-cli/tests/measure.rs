@@ -47,3 +47,30 @@ fn a_bad_csv_exits_2_naming_the_line() {
     assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
     assert!(err.contains("stretch.csv:3: column `force_n`"), "{err}");
 }
+
+#[cfg(feature = "hdf5")]
+#[test]
+fn a_fabrics_x_and_y_files_import_into_one_set_with_a_swatch_per_direction() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (x, y) = (format!("{DATA}/acrylic-rib-x.h5"), format!("{DATA}/acrylic-rib-y.h5"));
+    let o =
+        yarnhom(&["measure", "import-stitch-by-stitch", &x, &y, "-o", "set", "--every", "20"], dir.path());
+    assert!(o.status.success(), "import failed: {}", text(&o.stderr));
+    let fabric = std::fs::read_to_string(dir.path().join("set/fabric.toml")).expect("fabric.toml");
+    for expected in
+        ["name = \"acrylic-rib\"", "[swatch.weft]", "[swatch.warp]", "stretch_gauge_m", "compression_gauge_m"]
+    {
+        assert!(fabric.contains(expected), "missing '{expected}' in:\n{fabric}");
+    }
+    let o = yarnhom(&["measure", "check", "set"], dir.path());
+    let summary = text(&o.stdout);
+    assert!(summary.contains("weft load:") && summary.contains("warp load:"), "{summary}");
+    assert!(summary.contains("swatch (warp):") && summary.contains("stretch read over"), "{summary}");
+
+    let stock = format!("{DATA}/acrylic-stockinette-y.h5");
+    let o = yarnhom(&["measure", "import-stitch-by-stitch", &x, &stock, "-o", "mixed"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("pattern 'stockinette' differs from 'rib'"), "{}", text(&o.stderr));
+    let o = yarnhom(&["measure", "import-stitch-by-stitch", &x, &x, "-o", "twice"], dir.path());
+    assert!(text(&o.stderr).contains("a second file for direction 'weft'"), "{}", text(&o.stderr));
+}

@@ -7,13 +7,14 @@
 //!   with the anisotropic edge bending (6.4).
 
 use nalgebra::{Matrix3, Vector3, Vector6};
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_fit::{EnergyJet, SplineMaterial};
 
 /// The (6.1) parameters (J/m²): `k_xx, k_xy, k_yy, k_ss` of the StVK stiffness matrix on the
 /// Voigt Green strain `(E11, E22, 2 E12)`, and the Neo-Hookean area terms `k_n1 (J-1)²` and
 /// `k_n2 log² J`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct StvkNeoHookean {
     /// Weft stiffness.
     pub k_xx: f64,

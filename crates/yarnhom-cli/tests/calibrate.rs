@@ -1,0 +1,59 @@
+//! `yarnhom calibrate shell` on a synthetic set whose membrane is known, and on bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use yarnhom_calib::measure::Direction;
+use yarnhom_calib::synth::{SynthPlan, synthesize};
+use yarnhom_shell::StvkNeoHookean;
+
+fn yarnhom(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_yarnhom")).args(args).current_dir(cwd).output().expect("run yarnhom")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+#[test]
+fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let truth = StvkNeoHookean { k_xx: 80.0, k_xy: 10.0, k_yy: 30.0, k_ss: 12.0, k_n1: 3.0, k_n2: 1.0 };
+    let plan = SynthPlan {
+        directions: vec![Direction::Weft, Direction::Warp],
+        max_stretch: vec![0.25, 0.4],
+        force_noise_n: 0.01,
+        compression_noise: 0.001,
+        spacing_m: 0.01,
+        ..SynthPlan::new("synthetic", 0.3)
+    };
+    synthesize(&truth, &plan).expect("simulates").write(&dir.path().join("set")).expect("writes");
+    let o = yarnhom(
+        &["calibrate", "shell", "set", "-o", "out", "--spacing", "0.01", "--targets", "4"],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = text(&o.stdout);
+    for expected in ["weft", "warp", "mean", "not constrained by the data (held): k_ss", "17.6%"] {
+        assert!(summary.contains(expected), "missing '{expected}' in:\n{summary}");
+    }
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/shell-fit.json")).expect("json"))
+            .expect("parses");
+    assert_eq!(report["format"], "yarnhom.shell-fit");
+    assert!(report["errors"]["force"].as_f64().expect("number") < 0.03, "{}", report["errors"]);
+    let k_xx = report["material"]["k_xx"].as_f64().expect("number");
+    assert!((k_xx / 80.0 - 1.0).abs() < 0.1, "k_xx {k_xx}");
+    let svg = std::fs::read_to_string(dir.path().join("out/shell-fit.svg")).expect("svg");
+    assert!(svg.contains("synthetic warp: compression"), "figure has a panel per direction and quantity");
+}
+
+#[test]
+fn bad_calibration_input_is_refused_with_a_reason() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = yarnhom(&["calibrate", "shell", "missing", "-o", "out"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("missing/fabric.toml"), "{}", text(&o.stderr));
+    let o = yarnhom(&["calibrate", "shell", "missing", "-o", "out", "--force-cap=-1"], dir.path());
+    assert!(text(&o.stderr).contains("--force-cap must be a positive number"), "{}", text(&o.stderr));
+}
