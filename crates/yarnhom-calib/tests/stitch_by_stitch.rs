@@ -112,7 +112,11 @@ fn every_file_imports_and_round_trips() {
         }
         assert!(name.contains(&set.fabric.pattern), "{name}: pattern {}", set.fabric.pattern);
         let swatch = &set.fabric.swatch;
-        assert!((0.03..0.12).contains(&swatch.length_m) && (0.03..0.15).contains(&swatch.width_m), "{name}");
+        assert!((0.03..0.12).contains(&swatch.length_m) && (0.03..0.16).contains(&swatch.width_m), "{name}");
+        let (stretch_gauge, compression_gauge) =
+            (swatch.stretch_gauge_m.expect("pins"), swatch.compression_gauge_m.expect("pins"));
+        assert!(stretch_gauge > 0.5 * swatch.length_m && stretch_gauge < swatch.length_m, "{name}: {stretch_gauge}");
+        assert!(compression_gauge > 0.3 * swatch.width_m && compression_gauge <= swatch.width_m, "{name}");
         let dir = tempfile::tempdir().expect("tempdir");
         set.write(dir.path()).expect("write");
         assert_eq!(&MeasurementSet::read(dir.path()).expect("read back"), set, "{name}");
