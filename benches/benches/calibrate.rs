@@ -20,8 +20,15 @@ fn bench_objective(c: &mut Criterion) {
     let set = import_fabric(&files, 1).expect("the published files import").set;
     let targets = targets(&set, &TargetPlan::default()).expect("targets");
     // The membrane `yarnhom calibrate shell` fits to this set.
-    let material =
-        StvkNeoHookean { k_xx: 31.8, k_xy: -118.2, k_yy: 454.0, k_ss: 161.2, k_n1: 0.84, k_n2: 232.2 };
+    let material = StvkNeoHookean {
+        k_xx: 31.8,
+        k_xy: -118.2,
+        k_yy: 454.0,
+        k_ss: 161.2,
+        k_n1: 0.84,
+        k_n2: 232.2,
+        stiffening: None,
+    };
     let tests: Vec<(SwatchTest, Vec<f64>)> = [Direction::Weft, Direction::Warp]
         .into_iter()
         .map(|d| {

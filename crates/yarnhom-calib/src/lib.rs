@@ -5,6 +5,7 @@
 //! [`measure`] and `schemas/measurement-set.md`. [`stitch_by_stitch`] (feature `hdf5`) turns the
 //! published stitch-by-stitch HDF5 files into measurement sets.
 
+pub mod diagnose;
 pub mod lm;
 pub mod measure;
 pub mod shell_fit;
@@ -13,6 +14,8 @@ pub mod stitch_by_stitch;
 pub mod swatch;
 pub mod synth;
 pub mod targets;
+#[cfg(test)]
+mod test_support;
 pub mod uniform;
 
 pub use measure::{

@@ -19,7 +19,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_shell::StvkNeoHookean;
+use yarnhom_shell::{Stiffening, StvkNeoHookean};
 
 use crate::lm::{LmReport, LmSettings, minimize};
 use crate::measure::{Direction, MeasurementSet, Specimen};
@@ -151,58 +151,89 @@ pub enum ShellFitError {
     Start(StvkNeoHookean),
 }
 
-/// The fitted parameters: logs of the positive stiffnesses and `atanh` of the coupling ratio
-/// `k_xy / √(k_xx k_yy)`, which keeps the StVK matrix positive definite.
+/// Which extensions of plain anisotropic StVK a fit has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(crate) struct Terms {
+    /// The Neo-Hookean area terms of (6.1).
+    pub area: bool,
+    /// [`Stiffening`] past an onset strain.
+    pub stiffening: bool,
+}
+
+impl From<MembraneModel> for Terms {
+    fn from(model: MembraneModel) -> Self {
+        Terms { area: model == MembraneModel::StvkNeoHookean, stiffening: false }
+    }
+}
+
+/// The fitted parameters: logs of the positive stiffnesses (and of the stiffening onset) and
+/// `atanh` of the coupling ratio `k_xy / √(k_xx k_yy)`, which keeps the StVK matrix positive
+/// definite.
 #[derive(Debug, Clone, Copy)]
-struct Parameterization {
-    model: MembraneModel,
-    fit_shear: bool,
+pub(crate) struct Parameterization {
+    pub terms: Terms,
+    pub fit_shear: bool,
     /// Values of the parameters not fitted.
-    held: StvkNeoHookean,
+    pub held: StvkNeoHookean,
 }
 
 impl Parameterization {
-    fn encode(&self, m: &StvkNeoHookean) -> Vec<f64> {
+    pub fn encode(&self, m: &StvkNeoHookean) -> Vec<f64> {
         let mut p = vec![m.k_xx.ln(), m.k_yy.ln(), (m.k_xy / (m.k_xx * m.k_yy).sqrt()).atanh()];
         if self.fit_shear {
             p.push(m.k_ss.ln());
         }
-        if self.model == MembraneModel::StvkNeoHookean {
+        if self.terms.area {
             p.extend([m.k_n1.ln(), m.k_n2.ln()]);
+        }
+        if self.terms.stiffening {
+            let b = m.stiffening.expect("a stiffening term to encode");
+            p.extend([b.k_weft.ln(), b.k_warp.ln(), b.onset.ln()]);
         }
         p
     }
 
-    fn decode(&self, p: &[f64]) -> StvkNeoHookean {
+    pub fn decode(&self, p: &[f64]) -> StvkNeoHookean {
         let (k_xx, k_yy) = (p[0].exp(), p[1].exp());
         let mut m = StvkNeoHookean { k_xx, k_yy, k_xy: p[2].tanh() * (k_xx * k_yy).sqrt(), ..self.held };
-        let mut rest = p[3..].iter();
+        let mut rest = p[3..].iter().map(|x| x.exp());
+        let mut next = || rest.next().expect("encoded");
         if self.fit_shear {
-            m.k_ss = rest.next().expect("encoded").exp();
+            m.k_ss = next();
         }
-        if self.model == MembraneModel::StvkNeoHookean {
-            m.k_n1 = rest.next().expect("encoded").exp();
-            m.k_n2 = rest.next().expect("encoded").exp();
+        if self.terms.area {
+            (m.k_n1, m.k_n2) = (next(), next());
+        }
+        if self.terms.stiffening {
+            m.stiffening = Some(Stiffening { k_weft: next(), k_warp: next(), onset: next() });
         }
         m
     }
 
-    fn unconstrained(&self) -> Vec<String> {
+    pub fn unconstrained(&self) -> Vec<String> {
         if self.fit_shear { Vec::new() } else { vec!["k_ss".into()] }
     }
 }
 
-/// The measured data of one direction and its simulated swatch.
-struct DirectionData {
-    direction: Direction,
-    specimen: Specimen,
-    targets: Vec<Target>,
+/// The measured data of one direction: its swatch, its targets and which of them are fitted
+/// (the others are held out).
+pub(crate) struct DirectionData {
+    pub direction: Direction,
+    pub specimen: Specimen,
+    pub targets: Vec<Target>,
+    pub fitted: Vec<bool>,
     force_scale: f64,
     compression_scale: Option<f64>,
 }
 
 impl DirectionData {
-    fn group(set: &MeasurementSet, targets: &[Target]) -> Vec<DirectionData> {
+    /// Group `targets` by direction; `fitted(k)` says whether a direction's `k`-th target is
+    /// fitted.
+    pub fn group(
+        set: &MeasurementSet,
+        targets: &[Target],
+        fitted: impl Fn(usize) -> bool,
+    ) -> Vec<DirectionData> {
         Direction::ALL
             .into_iter()
             .filter_map(|direction| {
@@ -218,6 +249,7 @@ impl DirectionData {
                 (!mine.is_empty()).then(|| DirectionData {
                     direction,
                     specimen: set.fabric.swatch.specimen(direction),
+                    fitted: (0..mine.len()).map(&fitted).collect(),
                     targets: mine,
                     force_scale: force_scale.max(1e-12),
                     compression_scale,
@@ -226,20 +258,18 @@ impl DirectionData {
             .collect()
     }
 
-    fn stretches(&self) -> Vec<f64> {
+    pub fn stretches(&self) -> Vec<f64> {
         self.targets.iter().map(|t| t.stretch).collect()
     }
 
-    /// (6.2)'s weighted residuals of simulated `readings` (one per target).
-    fn residuals_of(&self, readings: &[SimulatedReading]) -> Vec<f64> {
-        let (f, c) = split(readings);
-        self.residuals(&f, &c)
-    }
-
-    /// (6.2)'s weighted residuals of forces and compressions (one per target).
-    fn residuals(&self, forces: &[f64], compressions: &[f64]) -> Vec<f64> {
+    /// (6.2)'s weighted residuals of the targets whose `fitted` flag is `which`, from forces and
+    /// compressions at every target.
+    pub fn residuals(&self, forces: &[f64], compressions: &[f64], which: bool) -> Vec<f64> {
         let mut r = Vec::with_capacity(2 * self.targets.len());
-        for ((t, f), c) in self.targets.iter().zip(forces).zip(compressions) {
+        for (k, ((t, f), c)) in self.targets.iter().zip(forces).zip(compressions).enumerate() {
+            if self.fitted[k] != which {
+                continue;
+            }
             r.push((f - t.force_n) / self.force_scale);
             if let (Some(measured), Some(scale)) = (t.compression, self.compression_scale) {
                 r.push((c - measured) / scale);
@@ -248,15 +278,19 @@ impl DirectionData {
         r
     }
 
-    fn errors(&self, forces: &[f64], compressions: &[f64]) -> (f64, Option<f64>) {
-        let rms = |d: Vec<f64>| (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt();
+    /// Force and compression errors (Sec. 6.3.1) over the targets whose `fitted` flag is `which`.
+    fn errors(&self, forces: &[f64], compressions: &[f64], which: bool) -> (f64, Option<f64>) {
+        let rms = |d: Vec<f64>| (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
+        let chosen =
+            || self.targets.iter().zip(&self.fitted).filter(move |(_, f)| **f == which).map(|(t, _)| t);
+        let picked = |values: &[f64]| -> Vec<f64> {
+            values.iter().zip(&self.fitted).filter(|(_, f)| **f == which).map(|(v, _)| *v).collect()
+        };
         let force =
-            rms(self.targets.iter().zip(forces).map(|(t, f)| f - t.force_n).collect()) / self.force_scale;
+            rms(chosen().zip(picked(forces)).map(|(t, f)| f - t.force_n).collect()) / self.force_scale;
         let compression = self.compression_scale.map(|scale| {
-            rms(self
-                .targets
-                .iter()
-                .zip(compressions)
+            rms(chosen()
+                .zip(picked(compressions))
                 .filter_map(|(t, c)| t.compression.map(|m| c - m))
                 .collect())
                 / scale
@@ -276,17 +310,22 @@ impl DirectionData {
     }
 }
 
-fn split(readings: &[SimulatedReading]) -> (Vec<f64>, Vec<f64>) {
+pub(crate) fn forces_and_compressions(readings: &[SimulatedReading]) -> (Vec<f64>, Vec<f64>) {
     readings.iter().map(|r| (r.force_n, r.compression)).unzip()
 }
 
-fn collect_errors(data: &[DirectionData], per_direction: &[Vec<SimulatedReading>]) -> FitErrors {
+/// Errors per direction and their means over the targets whose `fitted` flag is `which`.
+pub(crate) fn collect_errors(
+    data: &[DirectionData],
+    per_direction: &[Vec<SimulatedReading>],
+    which: bool,
+) -> FitErrors {
     let by_direction: Vec<(Direction, f64, Option<f64>)> = data
         .iter()
         .zip(per_direction)
         .map(|(d, readings)| {
-            let (f, c) = split(readings);
-            let (force, compression) = d.errors(&f, &c);
+            let (f, c) = forces_and_compressions(readings);
+            let (force, compression) = d.errors(&f, &c, which);
             (d.direction, force, compression)
         })
         .collect();
@@ -298,8 +337,9 @@ fn collect_errors(data: &[DirectionData], per_direction: &[Vec<SimulatedReading>
 }
 
 /// A starting material from the last target of each direction: `k ≈ σ / ((1 + s) E)` with
-/// `E = ((1 + s)² - 1) / 2`, the other axis copying a missing one.
-fn starting_material(data: &[DirectionData], model: MembraneModel) -> StvkNeoHookean {
+/// `E = ((1 + s)² - 1) / 2`, the other axis copying a missing one; area terms at 5% of the
+/// mean stiffness; stiffening as stiff as the StVK part, from half the largest Green strain.
+pub(crate) fn starting_material(data: &[DirectionData], terms: Terms) -> StvkNeoHookean {
     let stiffness = |direction: Direction| {
         data.iter().find(|d| d.direction == direction).and_then(|d| d.targets.last().map(|t| (d, t))).map(
             |(d, t)| {
@@ -313,7 +353,9 @@ fn starting_material(data: &[DirectionData], model: MembraneModel) -> StvkNeoHoo
     let any = weft.or(warp).or(bias).unwrap_or(1.0);
     let (k_xx, k_yy) = (weft.unwrap_or(any), warp.unwrap_or(any));
     let mean = (k_xx * k_yy).sqrt();
-    let area = if model == MembraneModel::StvkNeoHookean { 0.05 * mean } else { 0.0 };
+    let area = if terms.area { 0.05 * mean } else { 0.0 };
+    let largest = data.iter().flat_map(|d| d.targets.iter().map(|t| t.stretch)).fold(0.0, f64::max);
+    let onset = 0.25 * ((1.0 + largest).powi(2) - 1.0);
     StvkNeoHookean {
         k_xx,
         k_yy,
@@ -321,6 +363,68 @@ fn starting_material(data: &[DirectionData], model: MembraneModel) -> StvkNeoHoo
         k_ss: bias.map_or(0.4 * mean, |b| 0.5 * b),
         k_n1: area,
         k_n2: area,
+        stiffening: terms.stiffening.then_some(Stiffening {
+            k_weft: k_xx,
+            k_warp: k_yy,
+            onset: onset.max(1e-3),
+        }),
+    }
+}
+
+/// A fit problem: the data, the simulated swatches, and the prior on the encoded parameters.
+pub(crate) struct Problem {
+    pub data: Vec<DirectionData>,
+    pub tests: Vec<SwatchTest>,
+}
+
+impl Problem {
+    pub fn new(data: Vec<DirectionData>, spacing_m: f64) -> Self {
+        let tests = data.iter().map(|d| SwatchTest::new(d.direction, d.specimen, spacing_m)).collect();
+        Self { data, tests }
+    }
+
+    /// Every direction's swatch simulated at all its targets (`None` without equilibrium).
+    pub fn simulate(&self, m: &StvkNeoHookean) -> Option<Vec<Vec<SimulatedReading>>> {
+        self.tests.par_iter().zip(&self.data).map(|(test, d)| test.run(m, &d.stretches()).ok()).collect()
+    }
+
+    /// The fitted targets' residuals plus the prior `w (p - prior)`.
+    fn with_prior(p: &[f64], prior: &[f64], mut r: Vec<f64>) -> Vec<f64> {
+        r.extend(p.iter().zip(prior).map(|(a, b)| PRIOR_WEIGHT * (a - b)));
+        r
+    }
+
+    /// (6.2) with the uniform test in place of the swatch, from `start`: the encoded parameters.
+    pub fn screen(&self, parameterization: &Parameterization, start: &[f64], lm: &LmSettings) -> Vec<f64> {
+        let residuals = |p: &[f64]| {
+            let m = parameterization.decode(p);
+            let r = self.data.iter().flat_map(|d| {
+                let (f, c) = d.uniform(&m);
+                d.residuals(&f, &c, true)
+            });
+            Some(Self::with_prior(p, start, r.collect()))
+        };
+        let settings = LmSettings { max_iterations: 200, difference_step: 1e-6, ..*lm };
+        minimize(residuals, start, &settings).expect("the uniform test is evaluable everywhere").params
+    }
+
+    /// (6.2) with the clamped swatches simulated, from the encoded `start`, the prior at `prior`.
+    pub fn refine(
+        &self,
+        parameterization: &Parameterization,
+        start: &[f64],
+        prior: &[f64],
+        lm: &LmSettings,
+    ) -> Option<LmReport> {
+        let residuals = |p: &[f64]| {
+            let per_direction = self.simulate(&parameterization.decode(p))?;
+            let r = self.data.iter().zip(&per_direction).flat_map(|(d, r)| {
+                let (f, c) = forces_and_compressions(r);
+                d.residuals(&f, &c, true)
+            });
+            Some(Self::with_prior(p, prior, r.collect()))
+        };
+        minimize(residuals, start, lm)
     }
 }
 
@@ -328,66 +432,41 @@ fn starting_material(data: &[DirectionData], model: MembraneModel) -> StvkNeoHoo
 pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<ShellFit, ShellFitError> {
     let started = Instant::now();
     let targets = targets(set, &settings.plan)?;
-    let data = DirectionData::group(set, &targets);
-    let start = starting_material(&data, settings.model);
+    let problem = Problem::new(DirectionData::group(set, &targets, |_| true), settings.spacing_m);
+    let terms = Terms::from(settings.model);
+    let start = starting_material(&problem.data, terms);
     let parameterization = Parameterization {
-        model: settings.model,
-        fit_shear: data.iter().any(|d| d.direction == Direction::Bias),
+        terms,
+        fit_shear: problem.data.iter().any(|d| d.direction == Direction::Bias),
         held: start,
     };
     let prior = parameterization.encode(&start);
-    let with_prior = |p: &[f64], mut r: Vec<f64>| {
-        r.extend(p.iter().zip(&prior).map(|(a, b)| PRIOR_WEIGHT * (a - b)));
-        r
-    };
-    let uniform_residuals = |p: &[f64]| {
-        let m = parameterization.decode(p);
-        let r = data.iter().flat_map(|d| {
-            let (f, c) = d.uniform(&m);
-            d.residuals(&f, &c)
-        });
-        Some(with_prior(p, r.collect()))
-    };
-    let screening_run = minimize(
-        uniform_residuals,
-        &prior,
-        &LmSettings { max_iterations: 200, difference_step: 1e-6, ..settings.lm },
-    )
-    .expect("the uniform test is evaluable everywhere");
-    let screening = parameterization.decode(&screening_run.params);
-
-    let tests: Vec<SwatchTest> =
-        data.iter().map(|d| SwatchTest::new(d.direction, d.specimen, settings.spacing_m)).collect();
-    let simulate = |m: &StvkNeoHookean, tests: &[SwatchTest]| -> Option<Vec<Vec<SimulatedReading>>> {
-        tests.par_iter().zip(&data).map(|(test, d)| test.run(m, &d.stretches()).ok()).collect()
-    };
-    let swatch_residuals = |p: &[f64]| {
-        let per_direction = simulate(&parameterization.decode(p), &tests)?;
-        Some(with_prior(p, data.iter().zip(&per_direction).flat_map(|(d, r)| d.residuals_of(r)).collect()))
-    };
-    let screening_simulated = simulate(&screening, &tests).ok_or(ShellFitError::Start(screening))?;
-    let optimizer = minimize(swatch_residuals, &screening_run.params, &settings.lm)
+    let screened = problem.screen(&parameterization, &prior, &settings.lm);
+    let screening = parameterization.decode(&screened);
+    let screening_simulated = problem.simulate(&screening).ok_or(ShellFitError::Start(screening))?;
+    let optimizer = problem
+        .refine(&parameterization, &screened, &prior, &settings.lm)
         .ok_or(ShellFitError::Start(screening))?;
     let material = parameterization.decode(&optimizer.params);
-    let fitted = simulate(&material, &tests).ok_or(ShellFitError::Start(material))?;
-    let finer: Vec<SwatchTest> =
-        data.iter().map(|d| SwatchTest::new(d.direction, d.specimen, 0.5 * settings.spacing_m)).collect();
-    let refined = simulate(&material, &finer);
+    let fitted = problem.simulate(&material).ok_or(ShellFitError::Start(material))?;
+    let finer = Problem::new(DirectionData::group(set, &targets, |_| true), 0.5 * settings.spacing_m);
+    let refined = finer.simulate(&material);
+    let data = &problem.data;
     Ok(ShellFit {
         format: SHELL_FIT_FORMAT.into(),
         version: SHELL_FIT_VERSION,
         fabric: set.fabric.name.clone(),
         settings: *settings,
         screening,
-        screening_errors: collect_errors(&data, &screening_simulated),
+        screening_errors: collect_errors(data, &screening_simulated, true),
         material,
         unconstrained: parameterization.unconstrained(),
-        errors: collect_errors(&data, &fitted),
+        errors: collect_errors(data, &fitted, true),
         mesh_refinement_change: refined.map_or(f64::INFINITY, |r| largest_relative_change(&fitted, &r)),
         optimizer,
-        vertices: tests.iter().map(SwatchTest::vertex_count).max().unwrap_or(0),
+        vertices: problem.tests.iter().map(SwatchTest::vertex_count).max().unwrap_or(0),
         wall_time_s: started.elapsed().as_secs_f64(),
-        uniform_targets: uniform_targets(&material, &data, settings.plan.per_direction),
+        uniform_targets: uniform_targets(&material, data, settings.plan.per_direction),
         simulated: fitted.into_iter().flatten().collect(),
         targets,
     })
@@ -431,7 +510,15 @@ mod tests {
     use crate::synth::{SynthPlan, synthesize};
 
     fn truth() -> StvkNeoHookean {
-        StvkNeoHookean { k_xx: 60.0, k_xy: 12.0, k_yy: 25.0, k_ss: 9.0, k_n1: 4.0, k_n2: 1.5 }
+        StvkNeoHookean {
+            k_xx: 60.0,
+            k_xy: 12.0,
+            k_yy: 25.0,
+            k_ss: 9.0,
+            k_n1: 4.0,
+            k_n2: 1.5,
+            stiffening: None,
+        }
     }
 
     fn settings() -> ShellFitSettings {

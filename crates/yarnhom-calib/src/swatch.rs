@@ -258,11 +258,8 @@ fn locate(mesh: &ShellMesh, p: Vector2<f64>) -> Marker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_support::knit_membrane as material;
     use crate::uniform::uniaxial;
-
-    fn material() -> StvkNeoHookean {
-        StvkNeoHookean { k_xx: 120.0, k_xy: 30.0, k_yy: 40.0, k_ss: 25.0, k_n1: 5.0, k_n2: 2.0 }
-    }
 
     fn specimen(length_m: f64, width_m: f64) -> Specimen {
         Specimen { length_m, width_m, stretch_gauge_m: None, compression_gauge_m: None }

@@ -100,10 +100,7 @@ pub fn uniaxial(material: &StvkNeoHookean, direction: Direction, stretch: f64) -
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn material() -> StvkNeoHookean {
-        StvkNeoHookean { k_xx: 120.0, k_xy: 30.0, k_yy: 40.0, k_ss: 25.0, k_n1: 5.0, k_n2: 2.0 }
-    }
+    use crate::test_support::knit_membrane as material;
 
     #[test]
     fn the_compression_leaves_no_transverse_stress_and_the_stress_is_the_energy_slope() {
@@ -140,6 +137,7 @@ mod tests {
             k_ss: 0.5 * (1.0 - nu) * k,
             k_n1: 0.0,
             k_n2: 0.0,
+            stiffening: None,
         };
         for direction in Direction::ALL {
             let p = uniaxial(&m, direction, 1e-5);

@@ -1,15 +1,21 @@
-//! The committed shell-fit schema (`schemas/shell-fit.vN.schema.json`) is current.
+//! The committed calibration report schemas (`schemas/shell-fit.vN.schema.json`,
+//! `schemas/diagnosis.vN.schema.json`) are current.
 
+use yarnhom_calib::diagnose::{DIAGNOSIS_VERSION, diagnosis_schema};
 use yarnhom_calib::shell_fit::{SHELL_FIT_VERSION, shell_fit_schema};
 
 #[test]
-fn committed_shell_fit_schema_is_current() {
-    let path =
-        format!("{}/../../schemas/shell-fit.v{SHELL_FIT_VERSION}.schema.json", env!("CARGO_MANIFEST_DIR"));
-    let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let expected = serde_json::to_string_pretty(&shell_fit_schema()).expect("json") + "\n";
-    assert!(
-        committed == expected,
-        "{path} is stale; regenerate with `cargo run -p yarnhom-cli -- schema --write-all schemas`"
-    );
+fn committed_report_schemas_are_current() {
+    for (name, version, schema) in [
+        ("shell-fit", SHELL_FIT_VERSION, shell_fit_schema()),
+        ("diagnosis", DIAGNOSIS_VERSION, diagnosis_schema()),
+    ] {
+        let path = format!("{}/../../schemas/{name}.v{version}.schema.json", env!("CARGO_MANIFEST_DIR"));
+        let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let expected = serde_json::to_string_pretty(&schema).expect("json") + "\n";
+        assert!(
+            committed == expected,
+            "{path} is stale; regenerate with `cargo run -p yarnhom-cli -- schema --write-all schemas`"
+        );
+    }
 }

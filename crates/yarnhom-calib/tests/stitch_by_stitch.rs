@@ -115,7 +115,10 @@ fn every_file_imports_and_round_trips() {
         assert!((0.03..0.12).contains(&swatch.length_m) && (0.03..0.16).contains(&swatch.width_m), "{name}");
         let (stretch_gauge, compression_gauge) =
             (swatch.stretch_gauge_m.expect("pins"), swatch.compression_gauge_m.expect("pins"));
-        assert!(stretch_gauge > 0.5 * swatch.length_m && stretch_gauge < swatch.length_m, "{name}: {stretch_gauge}");
+        assert!(
+            stretch_gauge > 0.5 * swatch.length_m && stretch_gauge < swatch.length_m,
+            "{name}: {stretch_gauge}"
+        );
         assert!(compression_gauge > 0.3 * swatch.width_m && compression_gauge <= swatch.width_m, "{name}");
         let dir = tempfile::tempdir().expect("tempdir");
         set.write(dir.path()).expect("write");

@@ -5,9 +5,13 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use plotters::prelude::*;
+use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
+use yarnhom_calib::lm::LmSettings;
 use yarnhom_calib::measure::{Direction, MeasurementSet, Phase};
 use yarnhom_calib::shell_fit::{MembraneModel, ShellFit, ShellFitSettings, fit_shell};
-use yarnhom_calib::targets::TargetPlan;
+use yarnhom_calib::swatch::SimulatedReading;
+use yarnhom_calib::synth::{HiddenEffect, SynthPlan, ground_truth, synthesize};
+use yarnhom_calib::targets::{Target, TargetPlan};
 
 use crate::Outcome;
 use crate::fit_plot::{FONT, format_value, plot_error, render};
@@ -19,6 +23,75 @@ pub enum CalibrateCommand {
     /// write OUT/shell-fit.json (material, errors, uniform targets (6.3)) and
     /// OUT/shell-fit.svg (Fig. 6.6: force and compression vs stretch per direction).
     Shell(ShellArgs),
+    /// Diagnose what the base model (plain anisotropic StVK on the simulated clamped swatches)
+    /// gets wrong: fit it on half the targets, fit every testable extension of the cause
+    /// catalog, judge them on the held-out half and by an information criterion; write
+    /// OUT/report.json, OUT/report.md, OUT/fit.svg and OUT/residuals.svg.
+    Diagnose(DiagnoseArgs),
+    /// Write a synthetic measurement set: clamped stretch tests simulated on a known membrane
+    /// with an effect hidden in it, plus noise (for testing `calibrate diagnose`).
+    Synth(SynthArgs),
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum Budget {
+    /// Coarse swatches (8 mm), 10 optimizer iterations per model.
+    Quick,
+    /// 5 mm swatches, 30 iterations per model.
+    Normal,
+    /// 3.5 mm swatches, 80 iterations per model.
+    Thorough,
+}
+
+#[derive(Debug, Args)]
+pub struct DiagnoseArgs {
+    /// The measurement set directory.
+    pub set: PathBuf,
+    /// Output directory (created).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Targets per direction (even ones fitted, odd ones held out).
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(4..=60))]
+    pub targets: u32,
+    /// The stretch range ends where the measured force reaches this (N).
+    #[arg(long, default_value_t = 5.0)]
+    pub force_cap: f64,
+    /// Time against confidence: mesh size and optimizer iterations per model.
+    #[arg(long, value_enum, default_value = "normal")]
+    pub budget: Budget,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum EffectArg {
+    None,
+    AreaPreservation,
+    BiphasicStretch,
+    FrictionHysteresis,
+}
+
+#[derive(Debug, Args)]
+pub struct SynthArgs {
+    /// Output directory of the measurement set (created).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The effect hidden in the data.
+    #[arg(long, value_enum)]
+    pub effect: EffectArg,
+    /// Strength of the effect (1: clearly visible at 2% noise).
+    #[arg(long, default_value_t = 1.0)]
+    pub strength: f64,
+    /// Noise: standard deviation of force and compression as a fraction of their mean values.
+    #[arg(long, default_value_t = 0.02)]
+    pub noise: f64,
+    /// Seed of the noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Largest stretch of every direction.
+    #[arg(long, default_value_t = 0.4)]
+    pub max_stretch: f64,
+    /// Also write the ground truth (membrane and friction) as JSON here.
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -53,6 +126,8 @@ pub struct ShellArgs {
 pub fn run(cmd: CalibrateCommand) -> Result<Outcome> {
     match cmd {
         CalibrateCommand::Shell(args) => shell(args),
+        CalibrateCommand::Diagnose(args) => diagnose_command(args),
+        CalibrateCommand::Synth(args) => synth(args),
     }
 }
 
@@ -96,6 +171,176 @@ fn shell(args: ShellArgs) -> Result<Outcome> {
         .with_context(|| format!("cannot write {}", svg.display()))?;
     println!("{}", summary(&fit));
     eprintln!("wrote {} and {}", json.display(), svg.display());
+    Ok(Outcome::Success)
+}
+
+fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
+    anyhow::ensure!(
+        args.force_cap.is_finite() && args.force_cap > 0.0,
+        "--force-cap must be a positive number of newtons"
+    );
+    let set = MeasurementSet::read(&args.set)?;
+    let (spacing_m, max_iterations) = match args.budget {
+        Budget::Quick => (0.008, 10),
+        Budget::Normal => (0.005, 30),
+        Budget::Thorough => (0.0035, 80),
+    };
+    let settings = DiagnoseSettings {
+        targets_per_direction: args.targets as usize,
+        force_cap_n: args.force_cap,
+        spacing_m,
+        lm: LmSettings { max_iterations, ..LmSettings::default() },
+    };
+    eprintln!(
+        "diagnosing {} ({} readings): base and {} candidates ...",
+        set.fabric.name,
+        set.stretch.len(),
+        CauseId::CANDIDATES.len()
+    );
+    let d = diagnose(&set, &settings)?;
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("cannot create {}", args.output.display()))?;
+    let write = |name: &str, text: String| -> Result<()> {
+        let path = args.output.join(name);
+        std::fs::write(&path, text).with_context(|| format!("cannot write {}", path.display()))
+    };
+    write("report.json", serde_json::to_string_pretty(&d)?)?;
+    write("report.md", report_markdown(&d))?;
+    write("fit.svg", plot_diagnosis(&set, &d)?)?;
+    write("residuals.svg", plot_residuals(&d)?)?;
+    println!("cause: {} ({})", d.cause.id.as_str(), d.cause.explanation);
+    for line in &d.cause.evidence {
+        println!("  {line}");
+    }
+    println!(
+        "held-out error {:.4} -> {:.4}; {:.1} s",
+        d.gain.heldout_error_before, d.gain.heldout_error_after, d.wall_time_s
+    );
+    eprintln!("wrote {}/report.json, report.md, fit.svg, residuals.svg", args.output.display());
+    Ok(Outcome::Success)
+}
+
+/// `report.md`: the verdict, the evidence, the candidate table, the parameters, the figures.
+fn report_markdown(d: &Diagnosis) -> String {
+    let number = |x: f64| if x.is_finite() { format!("{x:.4}") } else { "-".into() };
+    let mut md = format!(
+        "# Diagnosis of {}
+
+**Cause: `{}`** — {}.
+
+## Evidence
+
+",
+        d.fabric,
+        d.cause.id.as_str(),
+        d.cause.explanation
+    );
+    for line in &d.cause.evidence {
+        md += &format!(
+            "- {line}
+"
+        );
+    }
+    md += &format!(
+        "
+Held-out error (RMS normalized residual on targets not fitted): {} before, {} after. Noise level {}.
+
+",
+        number(d.gain.heldout_error_before),
+        number(d.gain.heldout_error_after),
+        number(d.noise)
+    );
+    md += "## Candidates
+
+| model | testable | parameters | fitted error | held-out error | criterion (AIC) | note |
+|---|---|---|---|---|---|---|
+";
+    for m in std::iter::once(&d.base).chain(&d.candidates) {
+        md += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} |
+",
+            m.id,
+            if m.testable { "yes" } else { "no" },
+            m.parameter_count,
+            number(m.error),
+            number(m.heldout_error),
+            number(m.criterion),
+            m.note.as_deref().unwrap_or("")
+        );
+    }
+    for (title, model) in [("Base parameters", Some(&d.base)), ("Extended parameters", d.extended.as_ref())] {
+        let Some(model) = model else { continue };
+        md += &format!(
+            "
+## {title} ({})
+
+",
+            model.id
+        );
+        for (name, value) in &model.params {
+            md += &format!(
+                "- `{name}` = {value:.6}
+"
+            );
+        }
+    }
+    md += "
+## Figures
+
+![measured, base and extended](fit.svg)
+
+![residuals](residuals.svg)
+
+";
+    md += &format!(
+        "{} loading targets ({} fitted), {} unloading targets; {:.1} s.
+",
+        d.load_targets.len(),
+        d.load_fitted.iter().filter(|f| **f).count(),
+        d.unload_targets.len(),
+        d.wall_time_s
+    );
+    md
+}
+
+fn synth(args: SynthArgs) -> Result<Outcome> {
+    anyhow::ensure!(args.strength.is_finite() && args.strength >= 0.0, "--strength must be a number >= 0");
+    anyhow::ensure!(args.noise.is_finite() && args.noise >= 0.0, "--noise must be a number >= 0");
+    anyhow::ensure!(
+        args.max_stretch.is_finite() && args.max_stretch > 0.0 && args.max_stretch <= 2.0,
+        "--max-stretch must be in (0, 2]"
+    );
+    let effect = match args.effect {
+        EffectArg::None => HiddenEffect::None,
+        EffectArg::AreaPreservation => HiddenEffect::AreaPreservation,
+        EffectArg::BiphasicStretch => HiddenEffect::BiphasicStretch,
+        EffectArg::FrictionHysteresis => HiddenEffect::FrictionHysteresis,
+    };
+    let (truth, friction) = ground_truth(effect, args.strength);
+    let name = args.output.file_name().and_then(|n| n.to_str()).unwrap_or("synthetic").to_string();
+    let clean_plan = SynthPlan {
+        readings: 120,
+        unload_friction: Some(friction),
+        ..SynthPlan::new(&name, args.max_stretch)
+    };
+    let clean = synthesize(&truth, &clean_plan)?;
+    let mean = |f: &dyn Fn(&yarnhom_calib::StretchPoint) -> f64| {
+        clean.stretch.iter().map(|p| f(p).abs()).sum::<f64>() / clean.stretch.len() as f64
+    };
+    let plan = SynthPlan {
+        force_noise_n: args.noise * mean(&|p| p.force_n),
+        compression_noise: args.noise * mean(&|p| p.compression.unwrap_or(0.0)),
+        seed: args.seed,
+        ..clean_plan
+    };
+    let set = synthesize(&truth, &plan)?;
+    set.write(&args.output)?;
+    if let Some(path) = &args.truth {
+        let truth_json = serde_json::json!({ "membrane": truth, "unload_friction_h": friction, "effect": format!("{:?}", args.effect) });
+        std::fs::write(path, serde_json::to_string_pretty(&truth_json)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    eprintln!("wrote {} ({} readings)", args.output.display(), set.stretch.len());
     Ok(Outcome::Success)
 }
 
@@ -158,104 +403,328 @@ const MEASURED: RGBColor = RGBColor(0xB0, 0xB8, 0xC8);
 const TARGET: RGBColor = RGBColor(0x1F, 0x5F, 0xD0);
 const FITTED: RGBColor = RGBColor(0xC0, 0x30, 0x30);
 const UNIFORM: RGBColor = RGBColor(0x1A, 0x9A, 0x3A);
+const UNLOAD: RGBColor = RGBColor(0xE0, 0x90, 0x20);
+
+/// How a series is drawn.
+#[derive(Clone, Copy)]
+enum Mark {
+    /// Small filled dots (raw readings).
+    Speck(RGBColor),
+    /// Filled circles.
+    Dot(RGBColor),
+    /// Hollow circles.
+    Ring(RGBColor),
+    /// Crosses.
+    Cross(RGBColor),
+    /// A polyline.
+    Line(RGBColor),
+}
+
+struct Series {
+    label: String,
+    mark: Mark,
+    points: Vec<(f64, f64)>,
+}
+
+/// One chart of a figure: y against stretch.
+struct Panel {
+    title: String,
+    y_label: String,
+    series: Vec<Series>,
+}
+
+/// Draw `panels` in a grid of `columns` (row-major) as an SVG string.
+fn plot_panels(panels: &[Panel], columns: usize) -> Result<String> {
+    let rows = panels.len().div_ceil(columns.max(1));
+    let size = (420 * columns as u32, 380 * rows as u32);
+    render(size, |root| {
+        for (area, panel) in root.split_evenly((rows, columns)).iter().zip(panels) {
+            draw_panel(area, panel)?;
+        }
+        Ok(())
+    })
+}
+
+fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel: &Panel) -> Result<()> {
+    let points = || panel.series.iter().flat_map(|s| s.points.iter());
+    let x_max = points().map(|p| p.0).fold(0.0_f64, f64::max).max(1e-6) * 1.05;
+    let (lo, hi) = points().map(|p| p.1).fold((0.0_f64, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
+    let pad = 0.05 * (hi - lo).max(1e-9);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 16))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(55)
+        .build_cartesian_2d(0.0..x_max, (lo - pad)..(hi + pad))
+        .map_err(plot_error)?;
+    chart
+        .configure_mesh()
+        .x_desc("stretch")
+        .y_desc(panel.y_label.as_str())
+        .label_style((FONT, 12))
+        .x_label_formatter(&|x| format_value(*x))
+        .y_label_formatter(&|y| format_value(*y))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(plot_error)?;
+    for s in &panel.series {
+        let points = s.points.iter().copied();
+        let drawn = match s.mark {
+            Mark::Speck(c) => chart.draw_series(points.map(|p| Circle::new(p, 1, c.filled()))),
+            Mark::Dot(c) => chart.draw_series(points.map(|p| Circle::new(p, 4, c.filled()))),
+            Mark::Ring(c) => chart.draw_series(points.map(|p| Circle::new(p, 4, c.stroke_width(2)))),
+            Mark::Cross(c) => chart.draw_series(points.map(|p| Cross::new(p, 5, c.stroke_width(2)))),
+            Mark::Line(c) => chart.draw_series(LineSeries::new(points, c.stroke_width(2))),
+        }
+        .map_err(plot_error)?;
+        let mark = s.mark;
+        drawn.label(s.label.as_str()).legend(
+            move |(x, y)| -> DynElement<'static, SVGBackend<'_>, (i32, i32)> {
+                match mark {
+                    Mark::Line(c) => {
+                        PathElement::new(vec![(x - 8, y), (x + 8, y)], c.stroke_width(2)).into_dyn()
+                    }
+                    Mark::Cross(c) => Cross::new((x, y), 5, c.stroke_width(2)).into_dyn(),
+                    Mark::Ring(c) => Circle::new((x, y), 4, c.stroke_width(2)).into_dyn(),
+                    Mark::Speck(c) | Mark::Dot(c) => Circle::new((x, y), 3, c.filled()).into_dyn(),
+                }
+            },
+        );
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK.mix(0.5))
+        .label_font((FONT, 12))
+        .draw()
+        .map_err(plot_error)
+}
+
+/// The quantity of a figure row: force or compression.
+#[derive(Clone, Copy)]
+enum Quantity {
+    Force,
+    Compression,
+}
+
+impl Quantity {
+    fn label(self) -> &'static str {
+        match self {
+            Quantity::Force => "force (N)",
+            Quantity::Compression => "compression",
+        }
+    }
+
+    fn of(self, force_n: f64, compression: Option<f64>) -> Option<f64> {
+        match self {
+            Quantity::Force => Some(force_n),
+            Quantity::Compression => compression,
+        }
+    }
+
+    fn of_reading(self, r: &SimulatedReading) -> f64 {
+        match self {
+            Quantity::Force => r.force_n,
+            Quantity::Compression => r.compression,
+        }
+    }
+}
+
+/// Raw loading readings of `direction` up to `s_max`, thinned to about 1500 points.
+fn raw_readings(
+    set: &MeasurementSet,
+    direction: Direction,
+    phase: Phase,
+    s_max: f64,
+    q: Quantity,
+) -> Vec<(f64, f64)> {
+    let readings: Vec<_> = set
+        .stretch
+        .iter()
+        .filter(|p| p.direction == direction && p.phase == phase && p.stretch <= s_max)
+        .collect();
+    let thin = (readings.len() / 1500).max(1);
+    readings
+        .iter()
+        .step_by(thin)
+        .filter_map(|p| q.of(p.force_n, p.compression).map(|v| (p.stretch, v)))
+        .collect()
+}
+
+fn target_points<'a>(targets: impl Iterator<Item = &'a Target>, q: Quantity) -> Vec<(f64, f64)> {
+    targets.filter_map(|t| q.of(t.force_n, t.compression).map(|v| (t.stretch, v))).collect()
+}
 
 /// Fig. 6.6: per direction a column, force vs stretch on top and compression vs stretch below;
 /// raw loading readings (grey), targets (blue), the clamped-swatch fit (red), the uniform test
 /// of the fitted material (green, (6.3)).
 fn plot_shell_fit(set: &MeasurementSet, fit: &ShellFit) -> Result<String> {
     let directions: Vec<Direction> = fit.errors.by_direction.iter().map(|e| e.0).collect();
-    let size = (420 * directions.len() as u32, 760);
-    render(size, |root| {
-        let columns = root.split_evenly((2, directions.len()));
-        for (k, &direction) in directions.iter().enumerate() {
+    let mut panels = Vec::new();
+    for q in [Quantity::Force, Quantity::Compression] {
+        for &direction in &directions {
             let specimen = set.fabric.swatch.specimen(direction);
-            let targets: Vec<_> =
+            let mine: Vec<(usize, &Target)> =
                 fit.targets.iter().enumerate().filter(|(_, t)| t.direction == direction).collect();
-            let s_max = targets.iter().map(|(_, t)| t.stretch).fold(0.0, f64::max) * 1.05;
-            let readings: Vec<_> = set
-                .stretch
-                .iter()
-                .filter(|p| p.direction == direction && p.phase == Phase::Load && p.stretch <= s_max)
-                .collect();
-            let thin = (readings.len() / 1500).max(1);
-            let uniform: Vec<_> =
-                fit.uniform_targets.iter().filter(|u| u.direction == direction).map(|u| u.point).collect();
-            for (row, is_force) in [(0, true), (1, false)] {
-                let area = &columns[row * directions.len() + k];
-                let value =
-                    |force: f64, compression: Option<f64>| if is_force { Some(force) } else { compression };
-                let raw: Vec<(f64, f64)> = readings
-                    .iter()
-                    .step_by(thin)
-                    .filter_map(|p| value(p.force_n, p.compression).map(|v| (p.stretch, v)))
-                    .collect();
-                let measured: Vec<(f64, f64)> = targets
-                    .iter()
-                    .filter_map(|(_, t)| value(t.force_n, t.compression).map(|v| (t.stretch, v)))
-                    .collect();
-                let simulated: Vec<(f64, f64)> = targets
-                    .iter()
-                    .map(|(i, t)| {
-                        let r = fit.simulated[*i];
-                        (t.stretch, if is_force { r.force_n } else { r.compression })
-                    })
-                    .collect();
-                let line: Vec<(f64, f64)> = std::iter::once((0.0, 0.0))
-                    .chain(uniform.iter().map(|u| {
-                        (u.stretch, if is_force { u.stress_n_m * specimen.width_m } else { u.compression })
-                    }))
-                    .collect();
-                let ys = raw.iter().chain(&measured).chain(&simulated).chain(&line).map(|p| p.1);
-                let (lo, hi) = ys.fold((0.0_f64, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
-                let pad = 0.05 * (hi - lo).max(1e-9);
-                let quantity = if is_force { "force (N)" } else { "compression" };
-                let mut chart = ChartBuilder::on(area)
-                    .caption(format!("{} {direction}: {quantity}", fit.fabric), (FONT, 16))
-                    .margin(10)
-                    .x_label_area_size(40)
-                    .y_label_area_size(55)
-                    .build_cartesian_2d(0.0..s_max.max(1e-6), (lo - pad)..(hi + pad))
-                    .map_err(plot_error)?;
-                chart
-                    .configure_mesh()
-                    .x_desc("stretch")
-                    .y_desc(quantity)
-                    .label_style((FONT, 12))
-                    .x_label_formatter(&|x| format_value(*x))
-                    .y_label_formatter(&|y| format_value(*y))
-                    .light_line_style(WHITE.mix(0.0))
-                    .draw()
-                    .map_err(plot_error)?;
-                chart
-                    .draw_series(raw.iter().map(|&p| Circle::new(p, 1, MEASURED.filled())))
-                    .map_err(plot_error)?
-                    .label("readings (load)")
-                    .legend(|p| Circle::new(p, 2, MEASURED.filled()));
-                chart
-                    .draw_series(LineSeries::new(line.iter().copied(), UNIFORM.stroke_width(2)))
-                    .map_err(plot_error)?
-                    .label("uniform test (6.3)")
-                    .legend(|(x, y)| PathElement::new(vec![(x - 8, y), (x + 8, y)], UNIFORM.stroke_width(2)));
-                chart
-                    .draw_series(measured.iter().map(|&p| Circle::new(p, 4, TARGET.filled())))
-                    .map_err(plot_error)?
-                    .label("targets")
-                    .legend(|p| Circle::new(p, 4, TARGET.filled()));
-                chart
-                    .draw_series(simulated.iter().map(|&p| Cross::new(p, 5, FITTED.stroke_width(2))))
-                    .map_err(plot_error)?
-                    .label("clamped swatch, fitted")
-                    .legend(|p| Cross::new(p, 5, FITTED.stroke_width(2)));
-                chart
-                    .configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(BLACK.mix(0.5))
-                    .label_font((FONT, 12))
-                    .draw()
-                    .map_err(plot_error)?;
-            }
+            let s_max = mine.iter().map(|(_, t)| t.stretch).fold(0.0, f64::max) * 1.05;
+            let uniform = std::iter::once((0.0, 0.0)).chain(
+                fit.uniform_targets.iter().filter(|u| u.direction == direction).map(|u| {
+                    let p = u.point;
+                    (p.stretch, q.of(p.stress_n_m * specimen.width_m, Some(p.compression)).unwrap_or(0.0))
+                }),
+            );
+            panels.push(Panel {
+                title: format!("{} {direction}: {}", fit.fabric, q.label()),
+                y_label: q.label().into(),
+                series: vec![
+                    Series {
+                        label: "readings (load)".into(),
+                        mark: Mark::Speck(MEASURED),
+                        points: raw_readings(set, direction, Phase::Load, s_max, q),
+                    },
+                    Series {
+                        label: "uniform test (6.3)".into(),
+                        mark: Mark::Line(UNIFORM),
+                        points: uniform.collect(),
+                    },
+                    Series {
+                        label: "targets".into(),
+                        mark: Mark::Dot(TARGET),
+                        points: target_points(mine.iter().map(|(_, t)| *t), q),
+                    },
+                    Series {
+                        label: "clamped swatch, fitted".into(),
+                        mark: Mark::Cross(FITTED),
+                        points: mine
+                            .iter()
+                            .map(|(i, t)| (t.stretch, q.of_reading(&fit.simulated[*i])))
+                            .collect(),
+                    },
+                ],
+            });
         }
-        Ok(())
-    })
+    }
+    plot_panels(&panels, directions.len())
+}
+
+/// The predictions of `id` at `direction`'s targets (load or unload).
+fn predicted(d: &Diagnosis, id: &str, direction: Direction, unload: bool, q: Quantity) -> Vec<(f64, f64)> {
+    let Some(p) = d.predictions.iter().find(|p| p.id == id) else { return Vec::new() };
+    let (targets, readings) =
+        if unload { (&d.unload_targets, &p.unload) } else { (&d.load_targets, &p.load) };
+    targets
+        .iter()
+        .zip(readings)
+        .filter(|(t, _)| t.direction == direction)
+        .map(|(t, r)| (t.stretch, q.of_reading(r)))
+        .collect()
+}
+
+/// Measured against base and extended: per direction force and compression, fitted targets
+/// filled, held-out ones hollow, unloading in orange.
+fn plot_diagnosis(set: &MeasurementSet, d: &Diagnosis) -> Result<String> {
+    let directions: Vec<Direction> =
+        Direction::ALL.into_iter().filter(|x| d.load_targets.iter().any(|t| t.direction == *x)).collect();
+    let extended = d.extended.as_ref().map(|e| e.id.clone());
+    let mut panels = Vec::new();
+    for q in [Quantity::Force, Quantity::Compression] {
+        for &direction in &directions {
+            let s_max = d
+                .load_targets
+                .iter()
+                .filter(|t| t.direction == direction)
+                .map(|t| t.stretch)
+                .fold(0.0, f64::max)
+                * 1.05;
+            let split = |fitted: bool| {
+                target_points(
+                    d.load_targets
+                        .iter()
+                        .zip(&d.load_fitted)
+                        .filter(|(t, f)| t.direction == direction && **f == fitted)
+                        .map(|(t, _)| t),
+                    q,
+                )
+            };
+            let mut series = vec![
+                Series {
+                    label: "readings (load)".into(),
+                    mark: Mark::Speck(MEASURED),
+                    points: raw_readings(set, direction, Phase::Load, s_max, q),
+                },
+                Series { label: "fitted targets".into(), mark: Mark::Dot(TARGET), points: split(true) },
+                Series { label: "held-out targets".into(), mark: Mark::Ring(TARGET), points: split(false) },
+                Series {
+                    label: "base".into(),
+                    mark: Mark::Line(BLACK),
+                    points: predicted(d, "base", direction, false, q),
+                },
+            ];
+            if let Some(id) = &extended {
+                series.push(Series {
+                    label: id.clone(),
+                    mark: Mark::Line(FITTED),
+                    points: predicted(d, id, direction, false, q),
+                });
+            }
+            if d.unload_targets.iter().any(|t| t.direction == direction) {
+                series.push(Series {
+                    label: "unloading targets".into(),
+                    mark: Mark::Ring(UNLOAD),
+                    points: target_points(d.unload_targets.iter().filter(|t| t.direction == direction), q),
+                });
+                let id = extended.as_deref().unwrap_or("base");
+                series.push(Series {
+                    label: format!("{id}, unloading"),
+                    mark: Mark::Cross(UNLOAD),
+                    points: predicted(d, id, direction, true, q),
+                });
+            }
+            panels.push(Panel {
+                title: format!("{} {direction}: {}", d.fabric, q.label()),
+                y_label: q.label().into(),
+                series,
+            });
+        }
+    }
+    plot_panels(&panels, directions.len())
+}
+
+/// Residuals (model minus measured, over the measured value's scale) against stretch per
+/// direction and quantity, for the base and the extension, loading targets.
+fn plot_residuals(d: &Diagnosis) -> Result<String> {
+    let directions: Vec<Direction> =
+        Direction::ALL.into_iter().filter(|x| d.load_targets.iter().any(|t| t.direction == *x)).collect();
+    let mut panels = Vec::new();
+    for q in [Quantity::Force, Quantity::Compression] {
+        for &direction in &directions {
+            let mine: Vec<&Target> = d.load_targets.iter().filter(|t| t.direction == direction).collect();
+            let scale = mine.iter().filter_map(|t| q.of(t.force_n, t.compression)).map(f64::abs).sum::<f64>()
+                / mine.len().max(1) as f64;
+            let scale = scale.max(if matches!(q, Quantity::Compression) { 0.01 } else { 1e-12 });
+            let residual = |id: &str| -> Vec<(f64, f64)> {
+                predicted(d, id, direction, false, q)
+                    .into_iter()
+                    .zip(&mine)
+                    .filter_map(|((s, v), t)| q.of(t.force_n, t.compression).map(|m| (s, (v - m) / scale)))
+                    .collect()
+            };
+            let mut series =
+                vec![Series { label: "base".into(), mark: Mark::Dot(BLACK), points: residual("base") }];
+            if let Some(e) = &d.extended {
+                series.push(Series {
+                    label: e.id.clone(),
+                    mark: Mark::Cross(FITTED),
+                    points: residual(&e.id),
+                });
+            }
+            panels.push(Panel {
+                title: format!("{} {direction}: {} residual", d.fabric, q.label()),
+                y_label: "(model - measured) / mean".into(),
+                series,
+            });
+        }
+    }
+    plot_panels(&panels, directions.len())
 }

@@ -85,7 +85,8 @@ enum Command {
     #[command(subcommand)]
     Measure(measure::MeasureCommand),
     /// Fit models to a measurement set (thesis Ch. 6): `calibrate shell` fits the (6.1)
-    /// membrane by simulating the clamped swatch tests.
+    /// membrane by simulating the clamped swatch tests, `calibrate diagnose` names what the
+    /// base model gets wrong, `calibrate synth` writes sets with hidden effects.
     #[command(subcommand)]
     Calibrate(calibrate::CalibrateCommand),
 }

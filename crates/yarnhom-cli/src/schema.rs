@@ -12,8 +12,8 @@ pub struct SchemaArgs {
     /// Artifact kind (pattern, yarnmodel). Omit with --write-all.
     #[arg(required_unless_present = "write_all")]
     pub kind: Option<String>,
-    /// Write the current schema of every kind as DIR/KIND.vN.schema.json, of the shell-fit
-    /// report as DIR/shell-fit.vN.schema.json, and of every trace topic as
+    /// Write the current schema of every kind as DIR/KIND.vN.schema.json, of the calibration
+    /// reports as DIR/shell-fit.vN.schema.json and DIR/diagnosis.vN.schema.json, and of every trace topic as
     /// DIR/trace/SCHEMA_NAME.schema.json (how the committed `schemas/` folder is made).
     #[arg(long, value_name = "DIR", conflicts_with = "kind")]
     pub write_all: Option<PathBuf>,
@@ -27,11 +27,24 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
             yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
             eprintln!("wrote {}", path.display());
         }
-        let fit = yarnhom_calib::shell_fit::SHELL_FIT_VERSION;
-        let path = dir.join(format!("shell-fit.v{fit}.schema.json"));
-        let text = serde_json::to_string_pretty(&yarnhom_calib::shell_fit::shell_fit_schema())? + "\n";
-        yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
-        eprintln!("wrote {}", path.display());
+        let reports = [
+            (
+                "shell-fit",
+                yarnhom_calib::shell_fit::SHELL_FIT_VERSION,
+                yarnhom_calib::shell_fit::shell_fit_schema(),
+            ),
+            (
+                "diagnosis",
+                yarnhom_calib::diagnose::DIAGNOSIS_VERSION,
+                yarnhom_calib::diagnose::diagnosis_schema(),
+            ),
+        ];
+        for (name, version, schema) in reports {
+            let path = dir.join(format!("{name}.v{version}.schema.json"));
+            let text = serde_json::to_string_pretty(&schema)? + "\n";
+            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
+            eprintln!("wrote {}", path.display());
+        }
         let trace_dir = dir.join("trace");
         std::fs::create_dir_all(&trace_dir)?;
         for (_, name, schema) in yarnhom_trace::topic_schemas() {

@@ -18,7 +18,15 @@ fn text(bytes: &[u8]) -> String {
 #[test]
 fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let truth = StvkNeoHookean { k_xx: 80.0, k_xy: 10.0, k_yy: 30.0, k_ss: 12.0, k_n1: 3.0, k_n2: 1.0 };
+    let truth = StvkNeoHookean {
+        k_xx: 80.0,
+        k_xy: 10.0,
+        k_yy: 30.0,
+        k_ss: 12.0,
+        k_n1: 3.0,
+        k_n2: 1.0,
+        stiffening: None,
+    };
     let plan = SynthPlan {
         directions: vec![Direction::Weft, Direction::Warp],
         max_stretch: vec![0.25, 0.4],
@@ -56,4 +64,61 @@ fn bad_calibration_input_is_refused_with_a_reason() {
     assert!(text(&o.stderr).contains("missing/fabric.toml"), "{}", text(&o.stderr));
     let o = yarnhom(&["calibrate", "shell", "missing", "-o", "out", "--force-cap=-1"], dir.path());
     assert!(text(&o.stderr).contains("--force-cap must be a positive number"), "{}", text(&o.stderr));
+}
+
+#[test]
+fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let o = yarnhom(
+        &[
+            "calibrate",
+            "synth",
+            "-o",
+            "set",
+            "--effect",
+            "friction-hysteresis",
+            "--seed",
+            "3",
+            "--truth",
+            "truth.json",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(dir.path().join("truth.json").exists());
+    let o = yarnhom(&["calibrate", "diagnose", "set", "-o", "out", "--budget", "quick"], dir.path());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stdout).starts_with("cause: friction-hysteresis"), "{}", text(&o.stdout));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/report.json")).expect("json"))
+            .expect("parses");
+    for field in [
+        "/cause/id",
+        "/cause/explanation",
+        "/cause/evidence",
+        "/base/error",
+        "/extended/error",
+        "/extended/params",
+        "/gain/heldout_error_before",
+        "/gain/heldout_error_after",
+        "/candidates/0/id",
+        "/candidates/0/error",
+        "/candidates/0/criterion",
+    ] {
+        assert!(report.pointer(field).is_some(), "report.json lacks {field}");
+    }
+    let before = report.pointer("/gain/heldout_error_before").and_then(|v| v.as_f64()).expect("number");
+    let after = report.pointer("/gain/heldout_error_after").and_then(|v| v.as_f64()).expect("number");
+    assert!(after < before, "{after} vs {before}");
+    let md = std::fs::read_to_string(dir.path().join("out/report.md")).expect("md");
+    assert!(
+        md.contains("**Cause: `friction-hysteresis`**") && md.contains("| two-phase-contact | no |"),
+        "{md}"
+    );
+    for figure in ["fit.svg", "residuals.svg"] {
+        assert!(std::fs::read_to_string(dir.path().join("out").join(figure)).expect("svg").contains("<svg"));
+    }
+    let o = yarnhom(&["calibrate", "synth", "-o", "bad", "--effect", "none", "--noise=-1"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("--noise must be a number >= 0"), "{}", text(&o.stderr));
 }

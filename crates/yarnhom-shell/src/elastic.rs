@@ -233,7 +233,15 @@ mod tests {
     fn stvk() -> ShellMaterial {
         ShellMaterial::stvk(
             0.3,
-            StvkNeoHookean { k_xx: 3.0, k_xy: 0.5, k_yy: 1.0, k_ss: 0.7, k_n1: 0.2, k_n2: 0.1 },
+            StvkNeoHookean {
+                k_xx: 3.0,
+                k_xy: 0.5,
+                k_yy: 1.0,
+                k_ss: 0.7,
+                k_n1: 0.2,
+                k_n2: 0.1,
+                stiffening: None,
+            },
             HingeBending { k_weft: 1e-4, k_bias: 2e-4, k_warp: 3e-4 },
         )
     }

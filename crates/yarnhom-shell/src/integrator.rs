@@ -19,6 +19,7 @@ use yarnhom_rve::linear::SpdSolver;
 
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
 use crate::elastic::{Assembly, ElasticModel};
+use crate::line_search::backtrack;
 
 /// A piecewise linear translation over time (keyframes `(time_s, translation_m)`), constant
 /// before the first and after the last key.
@@ -234,7 +235,9 @@ impl Simulation {
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
             self.solver.solve_in_place(&mut dx, 1);
             let phi0 = phi.unwrap_or_else(|| self.potential(&x, &terms));
-            let (alpha, halvings, accepted) = self.line_search(&x, phi0, &dx, &a, &terms);
+            let slope = dot(&a.gradient, &dx);
+            let (alpha, halvings, accepted) =
+                backtrack(&x, &dx, phi0, slope, |trial| self.potential(trial, &terms));
             phi = accepted;
             stats.line_search_steps += halvings;
             stats.newton_iterations = iteration + 1;
@@ -363,34 +366,6 @@ impl Simulation {
             *g += kd / h;
         }
         a.triplets.extend(terms.stiffness_damping.iter().map(|&(i, j, v)| (i, j, v / h)));
-    }
-
-    /// Backtracking (Armijo) on `Φ` along `dx`: the step length and the number of halvings.
-    /// Also returns `Φ` at the accepted point (`None` if no step length was accepted), which
-    /// is the next iteration's `phi0`.
-    fn line_search(
-        &self,
-        x: &[Vector3<f64>],
-        phi0: f64,
-        dx: &[f64],
-        a: &Assembly,
-        terms: &StepTerms,
-    ) -> (f64, u32, Option<f64>) {
-        let slope = dot(&a.gradient, dx);
-        let mut alpha = 1.0;
-        for halvings in 0..30 {
-            let trial: Vec<_> = x
-                .iter()
-                .zip(dx.chunks_exact(3))
-                .map(|(p, d)| p + alpha * Vector3::new(d[0], d[1], d[2]))
-                .collect();
-            let phi = self.potential(&trial, terms);
-            if phi.is_finite() && phi <= phi0 + 1e-4 * alpha * slope {
-                return (alpha, halvings, Some(phi));
-            }
-            alpha *= 0.5;
-        }
-        (alpha, 30, None)
     }
 }
 

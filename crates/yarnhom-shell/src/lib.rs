@@ -18,6 +18,7 @@ pub mod elastic;
 pub mod forms;
 pub mod hinge;
 pub mod integrator;
+mod line_search;
 pub mod material;
 pub mod mesh;
 pub mod scene;
@@ -28,6 +29,6 @@ mod test_support;
 
 pub use elastic::{Assembly, ElasticModel};
 pub use integrator::{Dynamics, Handle, Motion, Simulation, StepStats};
-pub use material::{HingeBending, ShellMaterial, StvkNeoHookean};
+pub use material::{HingeBending, ShellMaterial, Stiffening, StvkNeoHookean};
 pub use mesh::ShellMesh;
 pub use scene::Scene;

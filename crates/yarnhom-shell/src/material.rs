@@ -28,6 +28,23 @@ pub struct StvkNeoHookean {
     pub k_n1: f64,
     /// `log² J` weight.
     pub k_n2: f64,
+    /// Stiffening past an onset strain, if any (not part of (6.1)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffening: Option<Stiffening>,
+}
+
+/// A biphasic membrane: `½ k_weft ⟨E11 - onset⟩₊² + ½ k_warp ⟨E22 - onset⟩₊²` added to (6.1),
+/// the shell-level analogue of the biphasic yarn stretch (6.5): the fabric stiffens once its
+/// Green strain along an axis passes `onset`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Stiffening {
+    /// Added stiffness along the weft past the onset (J/m²).
+    pub k_weft: f64,
+    /// Added stiffness along the warp past the onset (J/m²).
+    pub k_warp: f64,
+    /// Onset Green strain.
+    pub onset: f64,
 }
 
 /// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp.
@@ -119,10 +136,22 @@ impl StvkNeoHookean {
         let g = self.k_n1 * (j - 1.0).powi(2) + self.k_n2 * log_j * log_j;
         let dg = 2.0 * self.k_n1 * (j - 1.0) + 2.0 * self.k_n2 * log_j / j;
         let ddg = 2.0 * self.k_n1 + 2.0 * self.k_n2 * (1.0 - log_j) / (j * j);
-        let gradient = stvk_gradient + dg * d_j;
-        let hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
+        let mut gradient = stvk_gradient + dg * d_j;
+        let mut hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
+        let mut stiffening = 0.0;
+        if let Some(b) = &self.stiffening {
+            // E11 = (I11 - 1)/2 and E22 = (I22 - 1)/2: dE/dI = 1/2.
+            for (index, strain, k) in [(0, eps[0], b.k_weft), (2, eps[1], b.k_warp)] {
+                let excess = (strain - b.onset).max(0.0);
+                stiffening += 0.5 * k * excess * excess;
+                gradient[index] += 0.5 * k * excess;
+                if excess > 0.0 {
+                    hessian[(index, index)] += 0.25 * k;
+                }
+            }
+        }
         let mut jet = EnergyJet {
-            value: 0.5 * eps.dot(&(k * eps)) + g,
+            value: 0.5 * eps.dot(&(k * eps)) + g + stiffening,
             gradient: Vector6::zeros(),
             hessian: Default::default(),
         };
@@ -138,7 +167,15 @@ mod tests {
 
     #[test]
     fn stvk_derivatives_match_finite_differences_and_rest_is_stress_free() {
-        let m = StvkNeoHookean { k_xx: 3.0, k_xy: 0.5, k_yy: 1.0, k_ss: 0.7, k_n1: 0.2, k_n2: 0.1 };
+        let m = StvkNeoHookean {
+            k_xx: 3.0,
+            k_xy: 0.5,
+            k_yy: 1.0,
+            k_ss: 0.7,
+            k_n1: 0.2,
+            k_n2: 0.1,
+            stiffening: Some(Stiffening { k_weft: 5.0, k_warp: 2.0, onset: 0.1 }),
+        };
         let rest = m.jet([1.0, 0.0, 1.0]);
         assert!(rest.value.abs() < 1e-15 && rest.gradient.norm() < 1e-15);
         let first = [1.3, 0.2, 0.9];
@@ -160,7 +197,15 @@ mod tests {
     fn the_area_term_resists_inversion() {
         // Uniaxial compression of an isotropic StVK sheet: the Neo-Hookean log term grows
         // without bound as the area vanishes (Fig. 6.5).
-        let m = StvkNeoHookean { k_xx: 1.0, k_xy: 0.0, k_yy: 1.0, k_ss: 1.0, k_n1: 0.0, k_n2: 0.1 };
+        let m = StvkNeoHookean {
+            k_xx: 1.0,
+            k_xy: 0.0,
+            k_yy: 1.0,
+            k_ss: 1.0,
+            k_n1: 0.0,
+            k_n2: 0.1,
+            stiffening: None,
+        };
         let energy = |s: f64| m.jet([s * s, 0.0, 1.0]).value;
         assert!(energy(1e-3) > energy(0.1) && energy(0.1) > energy(0.5));
     }

@@ -7,6 +7,7 @@ use nalgebra::Vector3;
 use yarnhom_rve::linear::SpdSolver;
 
 use crate::elastic::{Assembly, ElasticModel};
+use crate::line_search::backtrack;
 
 /// When to stop.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -68,7 +69,7 @@ pub fn solve_static(
         factor_regularized(solver, &a)?;
         solver.solve_in_place(&mut dx, 1);
         let slope: f64 = a.gradient.iter().zip(&dx).map(|(g, d)| g * d).sum();
-        let (alpha, accepted) = backtrack(model, x, &dx, energy, slope);
+        let (alpha, _, accepted) = backtrack(x, &dx, energy, slope, |trial| model.energy(trial));
         let largest = alpha * dx.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         for (p, d) in x.iter_mut().zip(dx.chunks_exact(3)) {
             *p += alpha * Vector3::new(d[0], d[1], d[2]);
@@ -103,31 +104,6 @@ fn factor_regularized(solver: &mut SpdSolver, a: &Assembly) -> Result<(), Static
     Err(StaticError::Factorization)
 }
 
-/// Armijo backtracking on the energy along `dx`: the step length and the energy there, if a
-/// step was accepted (else the smallest step tried, energy unknown).
-fn backtrack(
-    model: &ElasticModel,
-    x: &[Vector3<f64>],
-    dx: &[f64],
-    energy: f64,
-    slope: f64,
-) -> (f64, Option<f64>) {
-    let mut alpha = 1.0;
-    for _ in 0..30 {
-        let trial: Vec<_> = x
-            .iter()
-            .zip(dx.chunks_exact(3))
-            .map(|(p, d)| p + alpha * Vector3::new(d[0], d[1], d[2]))
-            .collect();
-        let e = model.energy(&trial);
-        if e.is_finite() && e <= energy + 1e-4 * alpha * slope {
-            return (alpha, Some(e));
-        }
-        alpha *= 0.5;
-    }
-    (alpha, None)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -148,6 +124,7 @@ mod tests {
                 k_ss: 40.0,
                 k_n1: 0.0,
                 k_n2: 0.0,
+                stiffening: None,
             }),
             hinge_bending: None,
         };

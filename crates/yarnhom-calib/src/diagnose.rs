@@ -1,0 +1,594 @@
+//! Model-discrepancy diagnosis: what the base model gets wrong about a measured fabric, which
+//! cause from a fixed catalog explains it, and how much an extension for that cause gains on
+//! points it was not fitted to.
+//!
+//! The screening runs at the shell level, on the clamped swatches of the stretch tests
+//! ([`crate::shell_fit`]):
+//!
+//! 1. Targets: `n` stretches per direction (default 10) from the loading readings; the even
+//!    ones are fitted, the odd ones held out. Unloading readings, where the set has enough, give
+//!    unloading targets split the same way.
+//! 2. Base: plain anisotropic StVK (no area terms, no stiffening; unloading predicted as
+//!    loading), fitted by simulation in the loop.
+//! 3. Candidates, each a nested extension of the base, fitted from it:
+//!    `area-preservation` (the Neo-Hookean area terms of (6.1)), `biphasic-stretch`
+//!    ([`yarnhom_shell::Stiffening`]: stiffening past an onset strain), `friction-hysteresis`
+//!    (unloading force `(1 - h)` times the loading force at the same stretch, `h` fitted on the
+//!    even unloading targets). The bending causes (`rest-curvature`, `anisotropic-bending`)
+//!    need the pear-loop simulation and `two-phase-contact` the yarn-level fit; both are not
+//!    built yet, so these candidates are reported as not testable, with the reason.
+//! 4. Choice: a candidate is accepted when its held-out error is below 75% of the base's and
+//!    below it by more than twice the noise, and its Akaike criterion
+//!    `n ln(RSS/n) + 2k` on the fitted targets is lower by more than 4. The accepted candidate
+//!    with the lowest held-out error is the cause. Without one, the cause is `none` when the
+//!    base's held-out error is within `max(3 x noise, 3%)`, else `unexplained`.
+//!
+//! Errors are RMS values of the normalized residuals of (6.2) (force over the direction's mean
+//! force, compression over its mean compression), pooled over the fitted or the held-out
+//! targets; the noise is the pooled standard error of the targets (their readings' scatter
+//! about the local line over the square root of their count).
+
+use std::time::Instant;
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use yarnhom_shell::{Stiffening, StvkNeoHookean};
+
+use crate::lm::LmSettings;
+use crate::measure::{Direction, MeasurementSet, Phase};
+use crate::shell_fit::{
+    DirectionData, Parameterization, Problem, ShellFitError, Terms, forces_and_compressions,
+    starting_material,
+};
+use crate::swatch::SimulatedReading;
+use crate::targets::{Target, TargetPlan, targets};
+
+/// The catalog of causes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "kebab-case")]
+pub enum CauseId {
+    /// The yarn stiffens past an onset strain (e.g. plated yarns).
+    BiphasicStretch,
+    /// Soft then hard yarn compression.
+    TwoPhaseContact,
+    /// Stronger transverse contraction than the base shell can give.
+    AreaPreservation,
+    /// The fabric curls: an offset bending response.
+    RestCurvature,
+    /// Bending stiffness differs by direction.
+    AnisotropicBending,
+    /// Loading and unloading curves differ.
+    FrictionHysteresis,
+    /// Nothing significant at the noise level.
+    None,
+    /// Structured residuals that no candidate fixes.
+    Unexplained,
+}
+
+impl CauseId {
+    /// The id as written in reports.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            CauseId::BiphasicStretch => "biphasic-stretch",
+            CauseId::TwoPhaseContact => "two-phase-contact",
+            CauseId::AreaPreservation => "area-preservation",
+            CauseId::RestCurvature => "rest-curvature",
+            CauseId::AnisotropicBending => "anisotropic-bending",
+            CauseId::FrictionHysteresis => "friction-hysteresis",
+            CauseId::None => "none",
+            CauseId::Unexplained => "unexplained",
+        }
+    }
+
+    /// What the cause means physically.
+    pub fn explanation(self) -> &'static str {
+        match self {
+            CauseId::BiphasicStretch => {
+                "the fabric stiffens past an onset strain, as yarns do whose fibres or plies straighten and then \
+                 stretch (plated yarns, Sec. 6.4.1): the force grows faster at large stretch than one \
+                 strain-independent membrane allows"
+            }
+            CauseId::TwoPhaseContact => {
+                "yarn contacts are soft and then hard under compression (two-phase contact, (6.7))"
+            }
+            CauseId::AreaPreservation => {
+                "the fabric contracts across the pull more than a plain anisotropic StVK membrane can while \
+                 matching the force: it preserves area (the Neo-Hookean terms of (6.1))"
+            }
+            CauseId::RestCurvature => "the fabric curls at rest: its bending response is offset",
+            CauseId::AnisotropicBending => "the bending stiffness differs between directions",
+            CauseId::FrictionHysteresis => {
+                "unloading takes less force than loading at the same stretch: inter-yarn friction dissipates \
+                 energy (hysteresis, Sec. 6.2.3)"
+            }
+            CauseId::None => "the base model reproduces the held-out measurements within their noise",
+            CauseId::Unexplained => {
+                "the base model misses the held-out measurements by more than their noise, and no candidate \
+                 in the catalog fixes it"
+            }
+        }
+    }
+
+    /// The candidates screened, in report order.
+    pub const CANDIDATES: [CauseId; 6] = [
+        CauseId::AreaPreservation,
+        CauseId::BiphasicStretch,
+        CauseId::FrictionHysteresis,
+        CauseId::TwoPhaseContact,
+        CauseId::RestCurvature,
+        CauseId::AnisotropicBending,
+    ];
+}
+
+/// How to diagnose.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct DiagnoseSettings {
+    /// Targets per direction (even ones fitted, odd ones held out).
+    pub targets_per_direction: usize,
+    /// The stretch range ends where the measured force reaches this (N).
+    pub force_cap_n: f64,
+    /// Mesh edge length of the simulated swatches (m).
+    pub spacing_m: f64,
+    /// The simulation-in-the-loop iterations per model.
+    pub lm: LmSettings,
+}
+
+impl Default for DiagnoseSettings {
+    fn default() -> Self {
+        Self {
+            targets_per_direction: 10,
+            force_cap_n: 5.0,
+            spacing_m: 0.005,
+            lm: LmSettings { max_iterations: 30, ..LmSettings::default() },
+        }
+    }
+}
+
+/// One model's fit.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ModelResult {
+    /// `base` or a cause id.
+    pub id: String,
+    /// Whether it could be tested on this set.
+    pub testable: bool,
+    /// Why not, or what was done.
+    pub note: Option<String>,
+    /// The fitted parameters by name.
+    pub params: Vec<(String, f64)>,
+    /// Parameters fitted.
+    pub parameter_count: usize,
+    /// RMS normalized residual on the fitted targets.
+    pub error: f64,
+    /// RMS normalized residual on the held-out targets.
+    pub heldout_error: f64,
+    /// Akaike criterion on the fitted targets, `n ln(RSS/n) + 2k`.
+    pub criterion: f64,
+}
+
+/// The cause named.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Cause {
+    /// Catalog id.
+    pub id: CauseId,
+    /// What it means.
+    pub explanation: String,
+    /// The numbers behind the choice.
+    pub evidence: Vec<String>,
+}
+
+/// The held-out gain of the extension.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Gain {
+    /// The base's held-out error.
+    pub heldout_error_before: f64,
+    /// The chosen model's held-out error (the base's when the cause is `none`/`unexplained`).
+    pub heldout_error_after: f64,
+}
+
+/// A model's predictions at every loading (and unloading) target, for figures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Prediction {
+    /// `base` or a cause id.
+    pub id: String,
+    /// At the loading targets, in target order.
+    pub load: Vec<SimulatedReading>,
+    /// At the unloading targets, in target order.
+    pub unload: Vec<SimulatedReading>,
+}
+
+/// `report.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Diagnosis {
+    /// Format tag, `yarnhom.diagnosis`.
+    pub format: String,
+    /// Layout version.
+    pub version: u32,
+    /// The fabric's name.
+    pub fabric: String,
+    /// The settings used.
+    pub settings: DiagnoseSettings,
+    /// The cause.
+    pub cause: Cause,
+    /// The base model.
+    pub base: ModelResult,
+    /// The chosen extension, if a candidate was accepted.
+    pub extended: Option<ModelResult>,
+    /// Held-out errors before and after.
+    pub gain: Gain,
+    /// Every candidate of the catalog.
+    pub candidates: Vec<ModelResult>,
+    /// The noise level of the held-out targets (RMS normalized standard error).
+    pub noise: f64,
+    /// Loading targets.
+    pub load_targets: Vec<Target>,
+    /// Unloading targets (empty when the set has too few unloading readings).
+    pub unload_targets: Vec<Target>,
+    /// Whether each loading target was fitted (else held out).
+    pub load_fitted: Vec<bool>,
+    /// Predictions of the base and of the chosen extension.
+    pub predictions: Vec<Prediction>,
+    /// Wall time (s).
+    pub wall_time_s: f64,
+}
+
+/// Format tag of [`Diagnosis`] files.
+pub const DIAGNOSIS_FORMAT: &str = "yarnhom.diagnosis";
+/// Layout version of [`Diagnosis`] files.
+pub const DIAGNOSIS_VERSION: u32 = 1;
+
+/// The JSON Schema of `report.json`.
+pub fn diagnosis_schema() -> schemars::Schema {
+    schemars::schema_for!(Diagnosis)
+}
+
+/// The tests of a diagnosis: the loading and unloading problems, each with its held-out targets.
+struct Phases {
+    load: Problem,
+    unload: Option<Problem>,
+}
+
+/// Residuals of a model's predictions: `(fitted, held out)`, pooled over both phases.
+fn residuals(
+    phases: &Phases,
+    load: &[Vec<SimulatedReading>],
+    unload: &[Vec<SimulatedReading>],
+    unload_factor: f64,
+) -> (Vec<f64>, Vec<f64>) {
+    let mut fitted = Vec::new();
+    let mut heldout = Vec::new();
+    let mut add = |problem: &Problem, readings: &[Vec<SimulatedReading>], factor: f64| {
+        for (d, r) in problem.data.iter().zip(readings) {
+            let (f, c) = forces_and_compressions(r);
+            let f: Vec<f64> = f.iter().map(|x| x * factor).collect();
+            fitted.extend(d.residuals(&f, &c, true));
+            heldout.extend(d.residuals(&f, &c, false));
+        }
+    };
+    add(&phases.load, load, 1.0);
+    if let Some(u) = &phases.unload {
+        add(u, unload, unload_factor);
+    }
+    (fitted, heldout)
+}
+
+fn rms(r: &[f64]) -> f64 {
+    (r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64).sqrt()
+}
+
+fn criterion(r: &[f64], parameters: usize) -> f64 {
+    let n = r.len().max(1) as f64;
+    n * (r.iter().map(|x| x * x).sum::<f64>() / n).max(1e-300).ln() + 2.0 * parameters as f64
+}
+
+/// A fitted model: its material, unloading factor and predictions.
+struct Fitted {
+    material: StvkNeoHookean,
+    unload_factor: f64,
+    parameter_count: usize,
+    load: Vec<Vec<SimulatedReading>>,
+    unload: Vec<Vec<SimulatedReading>>,
+}
+
+impl Fitted {
+    fn result(&self, id: &str, phases: &Phases, note: Option<String>) -> ModelResult {
+        let (fitted, heldout) = residuals(phases, &self.load, &self.unload, self.unload_factor);
+        let m = &self.material;
+        let mut params = vec![
+            ("k_xx".to_string(), m.k_xx),
+            ("k_xy".to_string(), m.k_xy),
+            ("k_yy".to_string(), m.k_yy),
+            ("k_ss".to_string(), m.k_ss),
+        ];
+        if m.k_n1 > 0.0 || m.k_n2 > 0.0 {
+            params.extend([("k_n1".to_string(), m.k_n1), ("k_n2".to_string(), m.k_n2)]);
+        }
+        if let Some(b) = m.stiffening {
+            params.extend([
+                ("stiffening_k_weft".to_string(), b.k_weft),
+                ("stiffening_k_warp".to_string(), b.k_warp),
+                ("stiffening_onset".to_string(), b.onset),
+            ]);
+        }
+        if self.unload_factor != 1.0 {
+            params.push(("hysteresis_h".to_string(), 1.0 - self.unload_factor));
+        }
+        ModelResult {
+            id: id.into(),
+            testable: true,
+            note,
+            params,
+            parameter_count: self.parameter_count,
+            error: rms(&fitted),
+            heldout_error: rms(&heldout),
+            criterion: criterion(&fitted, self.parameter_count),
+        }
+    }
+
+    fn prediction(&self, id: &str) -> Prediction {
+        let scale = |r: &SimulatedReading| SimulatedReading { force_n: r.force_n * self.unload_factor, ..*r };
+        Prediction {
+            id: id.into(),
+            load: self.load.iter().flatten().copied().collect(),
+            unload: self.unload.iter().flatten().map(scale).collect(),
+        }
+    }
+}
+
+/// Fit the membrane with `terms` from `start`, simulating both phases.
+fn fit_model(
+    phases: &Phases,
+    terms: Terms,
+    start: StvkNeoHookean,
+    lm: &LmSettings,
+) -> Result<Fitted, ShellFitError> {
+    let parameterization = Parameterization {
+        terms,
+        fit_shear: phases.load.data.iter().any(|d| d.direction == Direction::Bias),
+        held: start,
+    };
+    let prior = parameterization.encode(&start);
+    let screened = phases.load.screen(&parameterization, &prior, lm);
+    // Start from the better of the screened point and the given one (an extension starts at
+    // the base's fit).
+    let cost = |p: &[f64]| {
+        let readings = phases.load.simulate(&parameterization.decode(p))?;
+        let r = phases.load.data.iter().zip(&readings).flat_map(|(d, r)| {
+            let (f, c) = forces_and_compressions(r);
+            d.residuals(&f, &c, true)
+        });
+        Some(r.map(|x| x * x).sum::<f64>())
+    };
+    let from = [screened.clone(), prior.clone()]
+        .into_iter()
+        .filter_map(|p| cost(&p).map(|c| (c, p)))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, p)| p)
+        .ok_or(ShellFitError::Start(start))?;
+    let report =
+        phases.load.refine(&parameterization, &from, &prior, lm).ok_or(ShellFitError::Start(start))?;
+    let material = parameterization.decode(&report.params);
+    let load = phases.load.simulate(&material).ok_or(ShellFitError::Start(material))?;
+    let unload = match &phases.unload {
+        Some(u) => u.simulate(&material).ok_or(ShellFitError::Start(material))?,
+        None => Vec::new(),
+    };
+    Ok(Fitted { material, unload_factor: 1.0, parameter_count: report.params.len(), load, unload })
+}
+
+/// The unloading factor `1 - h` fitting the even unloading targets' forces by least squares.
+fn hysteresis_factor(phases: &Phases, unload: &[Vec<SimulatedReading>]) -> Option<f64> {
+    let u = phases.unload.as_ref()?;
+    let (mut num, mut den) = (0.0, 0.0);
+    for (d, r) in u.data.iter().zip(unload) {
+        for ((t, reading), fitted) in d.targets.iter().zip(r).zip(&d.fitted) {
+            if *fitted {
+                num += reading.force_n * t.force_n;
+                den += reading.force_n * reading.force_n;
+            }
+        }
+    }
+    (den > 0.0).then(|| num / den)
+}
+
+fn untestable(id: CauseId, note: &str) -> ModelResult {
+    ModelResult {
+        id: id.as_str().into(),
+        testable: false,
+        note: Some(note.into()),
+        params: Vec::new(),
+        parameter_count: 0,
+        error: f64::NAN,
+        heldout_error: f64::NAN,
+        criterion: f64::NAN,
+    }
+}
+
+/// The noise level: the pooled RMS of the held-out targets' normalized standard errors.
+fn noise_level(phases: &Phases) -> f64 {
+    let mut errors = Vec::new();
+    for problem in std::iter::once(&phases.load).chain(phases.unload.as_ref()) {
+        for d in &problem.data {
+            let forces: Vec<f64> =
+                d.targets.iter().map(|t| t.force_n + t.force_noise_n / (t.readings as f64).sqrt()).collect();
+            let compressions: Vec<f64> = d
+                .targets
+                .iter()
+                .map(|t| {
+                    t.compression.unwrap_or(0.0)
+                        + t.compression_noise.unwrap_or(0.0) / (t.readings as f64).sqrt()
+                })
+                .collect();
+            errors.extend(d.residuals(&forces, &compressions, false));
+        }
+    }
+    rms(&errors)
+}
+
+/// Diagnose `set`.
+pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Diagnosis, ShellFitError> {
+    let started = Instant::now();
+    let plan = TargetPlan {
+        per_direction: settings.targets_per_direction,
+        force_cap_n: settings.force_cap_n,
+        phase: Phase::Load,
+    };
+    let load_targets = targets(set, &plan)?;
+    let even = |k: usize| k.is_multiple_of(2);
+    let unload_targets = targets(set, &TargetPlan { phase: Phase::Unload, ..plan }).ok();
+    let unload_note = match &unload_targets {
+        Some(_) => None,
+        None => Some("too few unloading readings to test".to_string()),
+    };
+    let phases = Phases {
+        load: Problem::new(DirectionData::group(set, &load_targets, even), settings.spacing_m),
+        unload: unload_targets
+            .as_ref()
+            .map(|t| Problem::new(DirectionData::group(set, t, even), settings.spacing_m)),
+    };
+    let noise = noise_level(&phases);
+
+    let base_terms = Terms::default();
+    let base_fit =
+        fit_model(&phases, base_terms, starting_material(&phases.load.data, base_terms), &settings.lm)?;
+    let base = base_fit.result("base", &phases, Some("anisotropic StVK, unloading as loading".into()));
+
+    let mut fits: Vec<(CauseId, Fitted)> = Vec::new();
+    let mut candidates = Vec::new();
+    for id in CauseId::CANDIDATES {
+        let extended = match id {
+            CauseId::AreaPreservation | CauseId::BiphasicStretch => {
+                let terms = Terms {
+                    area: id == CauseId::AreaPreservation,
+                    stiffening: id == CauseId::BiphasicStretch,
+                };
+                // Nested: start at the base's fit with the new terms a thousandth of their
+                // usual starting size, so the extension starts where the base ended.
+                let seed = starting_material(&phases.load.data, terms);
+                let start = StvkNeoHookean {
+                    k_n1: 1e-3 * seed.k_n1,
+                    k_n2: 1e-3 * seed.k_n2,
+                    stiffening: seed.stiffening.map(|b| Stiffening {
+                        k_weft: 1e-3 * b.k_weft,
+                        k_warp: 1e-3 * b.k_warp,
+                        ..b
+                    }),
+                    ..base_fit.material
+                };
+                fit_model(&phases, terms, start, &settings.lm).ok()
+            }
+            CauseId::FrictionHysteresis => {
+                hysteresis_factor(&phases, &base_fit.unload).map(|factor| Fitted {
+                    material: base_fit.material,
+                    unload_factor: factor,
+                    parameter_count: base_fit.parameter_count + 1,
+                    load: base_fit.load.clone(),
+                    unload: base_fit.unload.clone(),
+                })
+            }
+            _ => None,
+        };
+        let result = match (id, extended) {
+            (_, Some(f)) => {
+                let r = f.result(id.as_str(), &phases, None);
+                fits.push((id, f));
+                r
+            }
+            (CauseId::FrictionHysteresis, None) => {
+                untestable(id, unload_note.as_deref().unwrap_or("no unloading data"))
+            }
+            (CauseId::AreaPreservation | CauseId::BiphasicStretch, None) => {
+                untestable(id, "the extended swatch has no equilibrium from the base fit")
+            }
+            (CauseId::TwoPhaseContact, None) => untestable(
+                id,
+                "a yarn-level cause: screening it needs the yarn-level fit of Sec. 6.5, which is not built yet",
+            ),
+            (_, None) => untestable(
+                id,
+                if set.bending.is_empty() {
+                    "no bending tests in the set"
+                } else {
+                    "the pear-loop bending simulation of Sec. 6.3.2 is not built yet"
+                },
+            ),
+        };
+        candidates.push(result);
+    }
+
+    let passing: Vec<&ModelResult> = candidates
+        .iter()
+        .filter(|c| c.testable)
+        .filter(|c| {
+            c.heldout_error < 0.75 * base.heldout_error
+                && c.heldout_error < base.heldout_error - 2.0 * noise
+                && c.criterion < base.criterion - 4.0
+        })
+        .collect();
+    let accepted = passing.iter().min_by(|a, b| a.heldout_error.total_cmp(&b.heldout_error)).copied();
+    let mut evidence = vec![format!(
+        "base (anisotropic StVK): fitted error {:.4}, held-out error {:.4}, noise {:.4}",
+        base.error, base.heldout_error, noise
+    )];
+    for c in candidates.iter().filter(|c| c.testable) {
+        evidence.push(format!(
+            "{}: held-out error {:.4} ({:+.1}% vs base), criterion {:+.1} vs base",
+            c.id,
+            c.heldout_error,
+            100.0 * (c.heldout_error / base.heldout_error - 1.0),
+            c.criterion - base.criterion
+        ));
+    }
+    let (id, extended) = match accepted {
+        Some(c) => {
+            let id = CauseId::CANDIDATES.into_iter().find(|i| i.as_str() == c.id).expect("a catalog id");
+            (id, Some(c.clone()))
+        }
+        None if base.heldout_error <= (3.0 * noise).max(0.03) => (CauseId::None, None),
+        None => (CauseId::Unexplained, None),
+    };
+    evidence.push(match id {
+        CauseId::None => format!(
+            "no candidate passes the tests (held-out error below 75% of the base's, by more than 2 x noise, criterion lower by 4), and the base's held-out error {:.4} is within max(3 x noise, 0.03) = {:.4}",
+            base.heldout_error,
+            (3.0 * noise).max(0.03)
+        ),
+        CauseId::Unexplained => format!(
+            "no candidate passes the tests, and the base's held-out error {:.4} exceeds max(3 x noise, 0.03) = {:.4}",
+            base.heldout_error,
+            (3.0 * noise).max(0.03)
+        ),
+        _ => format!("chosen: {} (lowest held-out error among the candidates that pass the tests)", id.as_str()),
+    });
+    let also: Vec<&str> = passing.iter().map(|c| c.id.as_str()).filter(|c| *c != id.as_str()).collect();
+    if !also.is_empty() {
+        evidence.push(format!(
+            "also passing: {} (a combination may explain more; only single causes are screened)",
+            also.join(", ")
+        ));
+    }
+    let mut predictions = vec![base_fit.prediction("base")];
+    if let Some((cid, f)) = fits.iter().find(|(c, _)| *c == id) {
+        predictions.push(f.prediction(cid.as_str()));
+    }
+    let load_fitted = phases.load.data.iter().flat_map(|d| d.fitted.iter().copied()).collect();
+    Ok(Diagnosis {
+        format: DIAGNOSIS_FORMAT.into(),
+        version: DIAGNOSIS_VERSION,
+        fabric: set.fabric.name.clone(),
+        settings: *settings,
+        cause: Cause { id, explanation: id.explanation().into(), evidence },
+        gain: Gain {
+            heldout_error_before: base.heldout_error,
+            heldout_error_after: extended.as_ref().map_or(base.heldout_error, |e| e.heldout_error),
+        },
+        base,
+        extended,
+        candidates,
+        noise,
+        load_targets,
+        unload_targets: unload_targets.unwrap_or_default(),
+        load_fitted,
+        predictions,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    })
+}

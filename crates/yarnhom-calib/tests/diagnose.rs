@@ -1,0 +1,70 @@
+//! Hidden-effect tests: a synthetic set is made from a ground truth with one effect hidden in
+//! it (or none), and the diagnosis, told nothing about it, must name it.
+
+use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
+use yarnhom_calib::synth::{HiddenEffect, SynthPlan, ground_truth, synthesize};
+
+/// Relative noise: force and compression noise as this fraction of their mean clean values.
+const NOISE: f64 = 0.02;
+
+fn hidden(effect: HiddenEffect, strength: f64, seed: u64) -> Diagnosis {
+    let (truth, friction) = ground_truth(effect, strength);
+    let clean_plan = SynthPlan {
+        readings: 120,
+        spacing_m: 0.006,
+        unload_friction: Some(friction),
+        ..SynthPlan::new("hidden", 0.4)
+    };
+    let clean = synthesize(&truth, &clean_plan).expect("simulates");
+    let n = clean.stretch.len() as f64;
+    let mean_force = clean.stretch.iter().map(|p| p.force_n.abs()).sum::<f64>() / n;
+    let mean_compression = clean.stretch.iter().filter_map(|p| p.compression).map(f64::abs).sum::<f64>() / n;
+    let plan = SynthPlan {
+        force_noise_n: NOISE * mean_force,
+        compression_noise: NOISE * mean_compression,
+        seed,
+        ..clean_plan
+    };
+    let set = synthesize(&truth, &plan).expect("simulates");
+    let settings = DiagnoseSettings { spacing_m: 0.01, ..DiagnoseSettings::default() };
+    let d = diagnose(&set, &settings).expect("diagnoses");
+    eprintln!("{effect:?} x{strength}: {} ({:.1} s)", d.cause.id.as_str(), d.wall_time_s);
+    for line in &d.cause.evidence {
+        eprintln!("  {line}");
+    }
+    d
+}
+
+#[test]
+fn clean_data_of_the_base_model_is_diagnosed_none_and_untestable_causes_say_why() {
+    let d = hidden(HiddenEffect::None, 1.0, 11);
+    assert_eq!(d.cause.id, CauseId::None, "{:#?}", d.cause);
+    assert!(d.extended.is_none());
+    assert_eq!(d.gain.heldout_error_after, d.gain.heldout_error_before);
+    for id in ["two-phase-contact", "rest-curvature", "anisotropic-bending"] {
+        let c = d.candidates.iter().find(|c| c.id == id).expect("every catalog candidate is reported");
+        assert!(!c.testable && c.note.as_ref().is_some_and(|n| !n.is_empty()), "{c:?}");
+    }
+}
+
+#[test]
+fn a_hidden_area_preservation_is_found() {
+    let d = hidden(HiddenEffect::AreaPreservation, 1.0, 12);
+    assert_eq!(d.cause.id, CauseId::AreaPreservation, "{:#?}", d.cause);
+    assert!(d.gain.heldout_error_after < 0.75 * d.gain.heldout_error_before);
+}
+
+#[test]
+fn a_hidden_stiffening_is_found_as_biphasic_stretch() {
+    let d = hidden(HiddenEffect::BiphasicStretch, 1.0, 13);
+    assert_eq!(d.cause.id, CauseId::BiphasicStretch, "{:#?}", d.cause);
+}
+
+#[test]
+fn hidden_hysteresis_is_found_on_the_unloading_readings() {
+    let d = hidden(HiddenEffect::FrictionHysteresis, 1.0, 14);
+    assert_eq!(d.cause.id, CauseId::FrictionHysteresis, "{:#?}", d.cause);
+    let h =
+        d.extended.as_ref().expect("extended").params.iter().find(|p| p.0 == "hysteresis_h").expect("h").1;
+    assert!(h > 0.0, "unloading below loading: h = {h}");
+}
