@@ -157,12 +157,15 @@ pub struct ModelResult {
     pub params: Vec<(String, f64)>,
     /// Parameters fitted.
     pub parameter_count: usize,
-    /// RMS normalized residual on the fitted targets.
-    pub error: f64,
-    /// RMS normalized residual on the held-out targets.
-    pub heldout_error: f64,
-    /// Akaike criterion on the fitted targets, `n ln(RSS/n) + 2k`.
-    pub criterion: f64,
+    /// RMS normalized residual on the fitted targets (absent when not testable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<f64>,
+    /// RMS normalized residual on the held-out targets (absent when not testable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub heldout_error: Option<f64>,
+    /// Akaike criterion on the fitted targets, `n ln(RSS/n) + 2k` (absent when not testable).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub criterion: Option<f64>,
 }
 
 /// The cause named.
@@ -318,9 +321,9 @@ impl Fitted {
             note,
             params,
             parameter_count: self.parameter_count,
-            error: rms(&fitted),
-            heldout_error: rms(&heldout),
-            criterion: criterion(&fitted, self.parameter_count),
+            error: Some(rms(&fitted)),
+            heldout_error: Some(rms(&heldout)),
+            criterion: Some(criterion(&fitted, self.parameter_count)),
         }
     }
 
@@ -397,9 +400,9 @@ fn untestable(id: CauseId, note: &str) -> ModelResult {
         note: Some(note.into()),
         params: Vec::new(),
         parameter_count: 0,
-        error: f64::NAN,
-        heldout_error: f64::NAN,
-        criterion: f64::NAN,
+        error: None,
+        heldout_error: None,
+        criterion: None,
     }
 }
 
@@ -515,27 +518,32 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         candidates.push(result);
     }
 
+    // The scores of a tested model (the base and every testable candidate have them).
+    let score = |m: &ModelResult| {
+        (m.error.unwrap_or(f64::NAN), m.heldout_error.unwrap_or(f64::NAN), m.criterion.unwrap_or(f64::NAN))
+    };
+    let (base_error, base_heldout, base_criterion) = score(&base);
     let passing: Vec<&ModelResult> = candidates
         .iter()
         .filter(|c| c.testable)
         .filter(|c| {
-            c.heldout_error < 0.75 * base.heldout_error
-                && c.heldout_error < base.heldout_error - 2.0 * noise
-                && c.criterion < base.criterion - 4.0
+            let (_, heldout, criterion) = score(c);
+            heldout < 0.75 * base_heldout
+                && heldout < base_heldout - 2.0 * noise
+                && criterion < base_criterion - 4.0
         })
         .collect();
-    let accepted = passing.iter().min_by(|a, b| a.heldout_error.total_cmp(&b.heldout_error)).copied();
+    let accepted = passing.iter().min_by(|a, b| score(a).1.total_cmp(&score(b).1)).copied();
     let mut evidence = vec![format!(
-        "base (anisotropic StVK): fitted error {:.4}, held-out error {:.4}, noise {:.4}",
-        base.error, base.heldout_error, noise
+        "base (anisotropic StVK): fitted error {base_error:.4}, held-out error {base_heldout:.4}, noise {noise:.4}"
     )];
     for c in candidates.iter().filter(|c| c.testable) {
+        let (_, heldout, criterion) = score(c);
         evidence.push(format!(
-            "{}: held-out error {:.4} ({:+.1}% vs base), criterion {:+.1} vs base",
+            "{}: held-out error {heldout:.4} ({:+.1}% vs base), criterion {:+.1} vs base",
             c.id,
-            c.heldout_error,
-            100.0 * (c.heldout_error / base.heldout_error - 1.0),
-            c.criterion - base.criterion
+            100.0 * (heldout / base_heldout - 1.0),
+            criterion - base_criterion
         ));
     }
     let (id, extended) = match accepted {
@@ -543,18 +551,18 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
             let id = CauseId::CANDIDATES.into_iter().find(|i| i.as_str() == c.id).expect("a catalog id");
             (id, Some(c.clone()))
         }
-        None if base.heldout_error <= (3.0 * noise).max(0.03) => (CauseId::None, None),
+        None if base_heldout <= (3.0 * noise).max(0.03) => (CauseId::None, None),
         None => (CauseId::Unexplained, None),
     };
     evidence.push(match id {
         CauseId::None => format!(
             "no candidate passes the tests (held-out error below 75% of the base's, by more than 2 x noise, criterion lower by 4), and the base's held-out error {:.4} is within max(3 x noise, 0.03) = {:.4}",
-            base.heldout_error,
+            base_heldout,
             (3.0 * noise).max(0.03)
         ),
         CauseId::Unexplained => format!(
             "no candidate passes the tests, and the base's held-out error {:.4} exceeds max(3 x noise, 0.03) = {:.4}",
-            base.heldout_error,
+            base_heldout,
             (3.0 * noise).max(0.03)
         ),
         _ => format!("chosen: {} (lowest held-out error among the candidates that pass the tests)", id.as_str()),
@@ -578,8 +586,8 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         settings: *settings,
         cause: Cause { id, explanation: id.explanation().into(), evidence },
         gain: Gain {
-            heldout_error_before: base.heldout_error,
-            heldout_error_after: extended.as_ref().map_or(base.heldout_error, |e| e.heldout_error),
+            heldout_error_before: base_heldout,
+            heldout_error_after: extended.as_ref().map_or(base_heldout, |e| score(e).1),
         },
         base,
         extended,

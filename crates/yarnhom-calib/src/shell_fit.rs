@@ -117,8 +117,9 @@ pub struct ShellFit {
     pub simulated: Vec<SimulatedReading>,
     /// The fit's errors.
     pub errors: FitErrors,
-    /// The largest relative change of a simulated force or compression on a mesh twice as fine.
-    pub mesh_refinement_change: f64,
+    /// The largest relative change of a simulated force or compression on a mesh twice as fine
+    /// (absent if the finer swatch found no equilibrium).
+    pub mesh_refinement_change: Option<f64>,
     /// The optimizer's run.
     pub optimizer: LmReport,
     /// Vertices of the simulated swatch per direction.
@@ -462,7 +463,7 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         material,
         unconstrained: parameterization.unconstrained(),
         errors: collect_errors(data, &fitted, true),
-        mesh_refinement_change: refined.map_or(f64::INFINITY, |r| largest_relative_change(&fitted, &r)),
+        mesh_refinement_change: refined.map(|r| largest_relative_change(&fitted, &r)),
         optimizer,
         vertices: problem.tests.iter().map(SwatchTest::vertex_count).max().unwrap_or(0),
         wall_time_s: started.elapsed().as_secs_f64(),

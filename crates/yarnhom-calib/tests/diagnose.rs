@@ -41,6 +41,8 @@ fn clean_data_of_the_base_model_is_diagnosed_none_and_untestable_causes_say_why(
     assert_eq!(d.cause.id, CauseId::None, "{:#?}", d.cause);
     assert!(d.extended.is_none());
     assert_eq!(d.gain.heldout_error_after, d.gain.heldout_error_before);
+    let json = serde_json::to_string(&d).expect("serializes");
+    assert_eq!(serde_json::from_str::<Diagnosis>(&json).expect("reads back"), d, "report.json round-trips");
     for id in ["two-phase-contact", "rest-curvature", "anisotropic-bending"] {
         let c = d.candidates.iter().find(|c| c.id == id).expect("every catalog candidate is reported");
         assert!(!c.testable && c.note.as_ref().is_some_and(|n| !n.is_empty()), "{c:?}");

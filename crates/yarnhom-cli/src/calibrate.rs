@@ -222,7 +222,8 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
 
 /// `report.md`: the verdict, the evidence, the candidate table, the parameters, the figures.
 fn report_markdown(d: &Diagnosis) -> String {
-    let number = |x: f64| if x.is_finite() { format!("{x:.4}") } else { "-".into() };
+    let number = |x: f64| format!("{x:.4}");
+    let maybe = |x: Option<f64>| x.map_or("-".into(), number);
     let mut md = format!(
         "# Diagnosis of {}
 
@@ -262,9 +263,9 @@ Held-out error (RMS normalized residual on targets not fitted): {} before, {} af
             m.id,
             if m.testable { "yes" } else { "no" },
             m.parameter_count,
-            number(m.error),
-            number(m.heldout_error),
-            number(m.criterion),
+            maybe(m.error),
+            maybe(m.heldout_error),
+            maybe(m.criterion),
             m.note.as_deref().unwrap_or("")
         );
     }
@@ -387,14 +388,12 @@ fn summary(fit: &ShellFit) -> String {
         percent(Some(fit.errors.force)),
         percent(fit.errors.compression)
     ));
+    let refinement = fit.mesh_refinement_change.map_or("no equilibrium on the finer mesh".into(), |c| {
+        format!("a mesh twice as fine changes a reading by {:.1}%", 100.0 * c)
+    });
     lines.push(format!(
-        "  {} Levenberg-Marquardt iterations, {} swatch simulations, {:.1} s; {} vertices per swatch; \
-         a mesh twice as fine changes a reading by {:.1}%",
-        fit.optimizer.iterations,
-        fit.optimizer.evaluations,
-        fit.wall_time_s,
-        fit.vertices,
-        100.0 * fit.mesh_refinement_change
+        "  {} Levenberg-Marquardt iterations, {} swatch simulations, {:.1} s; {} vertices per swatch; {refinement}",
+        fit.optimizer.iterations, fit.optimizer.evaluations, fit.wall_time_s, fit.vertices,
     ));
     lines.join("\n")
 }
