@@ -8,6 +8,7 @@
 pub mod diagnose;
 pub mod lm;
 pub mod measure;
+pub mod pear_loop;
 pub mod shell_fit;
 #[cfg(feature = "hdf5")]
 pub mod stitch_by_stitch;

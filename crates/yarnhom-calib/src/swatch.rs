@@ -203,8 +203,14 @@ impl SwatchTest {
             }
         }
         state.clamp_stretch = clamp_stretch;
-        let stats =
-            solve_static(model, &mut state.x, &self.fixed, StaticSettings::default(), &mut state.solver)?;
+        let stats = solve_static(
+            model,
+            &mut state.x,
+            &self.fixed,
+            &[],
+            StaticSettings::default(),
+            &mut state.solver,
+        )?;
         if !stats.converged {
             return Err(SwatchError::NotConverged {
                 direction: self.direction,

@@ -8,10 +8,13 @@ use plotters::prelude::*;
 use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
 use yarnhom_calib::lm::LmSettings;
 use yarnhom_calib::measure::{Direction, MeasurementSet, Phase};
+use yarnhom_calib::pear_loop::PearLoopTest;
 use yarnhom_calib::shell_fit::{MembraneModel, ShellFit, ShellFitSettings, fit_shell};
 use yarnhom_calib::swatch::SimulatedReading;
 use yarnhom_calib::synth::{HiddenEffect, SynthPlan, ground_truth, synthesize};
 use yarnhom_calib::targets::{Target, TargetPlan};
+
+use yarnhom_shell::HingeBending;
 
 use crate::Outcome;
 use crate::fit_plot::{FONT, format_value, plot_error, render};
@@ -31,6 +34,43 @@ pub enum CalibrateCommand {
     /// Write a synthetic measurement set: clamped stretch tests simulated on a known membrane
     /// with an effect hidden in it, plus noise (for testing `calibrate diagnose`).
     Synth(SynthArgs),
+    /// Simulate the pear-loop bending test (Sec. 6.2.3, 6.3.2): a strip of a given weight,
+    /// membrane and hinge bending (6.4) clamped into a loop at each clamp distance; print the
+    /// loop's height, width and aspect ratio (to choose distances where the test is sensitive).
+    PearLoop(PearLoopArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct PearLoopArgs {
+    /// Direction of the strip's long axis.
+    #[arg(long, default_value = "weft", value_parser = parse_direction)]
+    pub direction: Direction,
+    /// Free length between the clamps (m).
+    #[arg(long, default_value_t = 0.10)]
+    pub length: f64,
+    /// Strip width (m).
+    #[arg(long, default_value_t = 0.06)]
+    pub width: f64,
+    /// Areal density (kg/m²).
+    #[arg(long)]
+    pub density: f64,
+    /// Hinge stiffnesses `k_weft,k_bias,k_warp` (J), or one value for all.
+    #[arg(long, value_delimiter = ',', num_args = 1..=3, required = true)]
+    pub bending: Vec<f64>,
+    /// The membrane: a `shell-fit.json` of `calibrate shell` (default: a knit-like anisotropic
+    /// StVK, 60 / 25 J/m²).
+    #[arg(long)]
+    pub membrane: Option<PathBuf>,
+    /// Clamp distances (m).
+    #[arg(long, value_delimiter = ',', required = true)]
+    pub distances: Vec<f64>,
+    /// Mesh edge length (m).
+    #[arg(long, default_value_t = 0.005)]
+    pub spacing: f64,
+}
+
+fn parse_direction(name: &str) -> Result<Direction, String> {
+    Direction::parse(name).ok_or_else(|| format!("unknown direction '{name}' (weft, bias, warp)"))
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -128,6 +168,7 @@ pub fn run(cmd: CalibrateCommand) -> Result<Outcome> {
         CalibrateCommand::Shell(args) => shell(args),
         CalibrateCommand::Diagnose(args) => diagnose_command(args),
         CalibrateCommand::Synth(args) => synth(args),
+        CalibrateCommand::PearLoop(args) => pear_loop(args),
     }
 }
 
@@ -342,6 +383,38 @@ fn synth(args: SynthArgs) -> Result<Outcome> {
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
     eprintln!("wrote {} ({} readings)", args.output.display(), set.stretch.len());
+    Ok(Outcome::Success)
+}
+
+fn pear_loop(args: PearLoopArgs) -> Result<Outcome> {
+    let positive = |x: f64| x.is_finite() && x > 0.0;
+    anyhow::ensure!(
+        positive(args.length) && positive(args.width) && positive(args.spacing),
+        "--length, --width and --spacing must be positive lengths in metres"
+    );
+    anyhow::ensure!(positive(args.density), "--density must be a positive areal density in kg/m²");
+    anyhow::ensure!(args.bending.iter().all(|k| positive(*k)), "--bending stiffnesses must be positive (J)");
+    let bending = match args.bending[..] {
+        [k] => HingeBending { k_weft: k, k_bias: k, k_warp: k },
+        [k_weft, k_bias, k_warp] => HingeBending { k_weft, k_bias, k_warp },
+        _ => anyhow::bail!("--bending takes one stiffness or three (k_weft,k_bias,k_warp)"),
+    };
+    let membrane = match &args.membrane {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+            let fit: ShellFit = serde_json::from_str(&text)
+                .with_context(|| format!("{}: not a shell-fit.json", path.display()))?;
+            fit.material
+        }
+        None => ground_truth(HiddenEffect::None, 0.0).0,
+    };
+    let test = PearLoopTest::new(args.direction, args.length, args.width, args.density, args.spacing);
+    let readings = test.run(&membrane, &bending, &args.distances)?;
+    println!("clamp_distance_m,height_m,width_m,aspect_ratio");
+    for r in readings {
+        println!("{},{},{},{}", r.clamp_distance_m, r.height_m, r.width_m, r.aspect_ratio);
+    }
     Ok(Outcome::Success)
 }
 

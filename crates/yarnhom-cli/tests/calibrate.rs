@@ -122,3 +122,21 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("--noise must be a number >= 0"), "{}", text(&o.stderr));
 }
+
+#[test]
+fn pear_loop_prints_a_loop_per_clamp_distance_and_refuses_impossible_ones() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let args = ["calibrate", "pear-loop", "--density", "0.25", "--width", "0.02", "--bending", "1e-6"];
+    let o = yarnhom(&[&args[..], &["--distances", "0.005,0.03"]].concat(), dir.path());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    let rows: Vec<Vec<f64>> =
+        out.lines().skip(1).map(|l| l.split(',').map(|x| x.parse().expect("number")).collect()).collect();
+    assert_eq!(out.lines().next(), Some("clamp_distance_m,height_m,width_m,aspect_ratio"));
+    assert_eq!(rows.len(), 2);
+    // Closer clamps: a narrower loop of about the same depth, so a larger aspect ratio.
+    assert!(rows[0][2] < rows[1][2] && rows[0][3] > rows[1][3], "{out}");
+    let o = yarnhom(&[&args[..], &["--distances", "0.2"]].concat(), dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("does not form a loop"), "{}", text(&o.stderr));
+}

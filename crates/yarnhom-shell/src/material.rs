@@ -48,7 +48,7 @@ pub struct Stiffening {
 }
 
 /// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct HingeBending {
     /// Bending that curves the weft (X) direction.
     pub k_weft: f64,

@@ -46,22 +46,31 @@ pub enum StaticError {
     Diverged,
 }
 
-/// Minimize the elastic energy of `model` over the DOFs of `x` not marked `fixed` (one flag
-/// per DOF, `3 n`), starting from `x` and leaving the equilibrium in it. `solver` keeps its
-/// symbolic analysis across calls on the same mesh.
+/// Minimize the elastic energy of `model` minus the work of the constant vertex `loads` (N;
+/// empty for none, e.g. weights `m g` for gravity) over the DOFs of `x` not marked `fixed`
+/// (one flag per DOF, `3 n`), starting from `x` and leaving the equilibrium in it. `solver`
+/// keeps its symbolic analysis across calls on the same mesh.
 pub fn solve_static(
     model: &ElasticModel,
     x: &mut [Vector3<f64>],
     fixed: &[bool],
+    loads: &[Vector3<f64>],
     settings: StaticSettings,
     solver: &mut SpdSolver,
 ) -> Result<StaticStats, StaticError> {
+    let potential =
+        |x: &[Vector3<f64>]| model.energy(x) - loads.iter().zip(x).map(|(f, p)| f.dot(p)).sum::<f64>();
     let mut a = Assembly::new(3 * x.len());
     let mut stats = StaticStats { iterations: 0, residual_n: f64::INFINITY, converged: false };
-    let mut energy = model.energy(x);
+    let mut energy = potential(x);
     for iteration in 0..settings.max_iterations {
         a.clear();
         model.assemble(x, true, &mut a);
+        for (v, f) in loads.iter().enumerate() {
+            for k in 0..3 {
+                a.gradient[3 * v + k] -= f[k];
+            }
+        }
         a.pin(fixed);
         stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
         stats.iterations = iteration + 1;
@@ -69,7 +78,7 @@ pub fn solve_static(
         factor_regularized(solver, &a)?;
         solver.solve_in_place(&mut dx, 1);
         let slope: f64 = a.gradient.iter().zip(&dx).map(|(g, d)| g * d).sum();
-        let (alpha, _, accepted) = backtrack(x, &dx, energy, slope, |trial| model.energy(trial));
+        let (alpha, _, accepted) = backtrack(x, &dx, energy, slope, potential);
         let largest = alpha * dx.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
         for (p, d) in x.iter_mut().zip(dx.chunks_exact(3)) {
             *p += alpha * Vector3::new(d[0], d[1], d[2]);
@@ -77,7 +86,7 @@ pub fn solve_static(
         if x.iter().any(|p| !p.iter().all(|c| c.is_finite())) {
             return Err(StaticError::Diverged);
         }
-        energy = accepted.unwrap_or_else(|| model.energy(x));
+        energy = accepted.unwrap_or_else(|| potential(x));
         if largest < settings.tolerance_m {
             stats.converged = true;
             break;
@@ -140,7 +149,7 @@ mod tests {
             }
         }
         let stats =
-            solve_static(&model, &mut x, &fixed, StaticSettings::default(), &mut SpdSolver::default())
+            solve_static(&model, &mut x, &fixed, &[], StaticSettings::default(), &mut SpdSolver::default())
                 .expect("solves");
         assert!(stats.converged, "{stats:?}");
         let mut a = Assembly::new(3 * x.len());
