@@ -84,4 +84,10 @@ if [ "$status" -ne 1 ]; then
   echo "unexpected: diff of two different materials exited $status" >&2
   exit 1
 fi
+echo "== calibration (Ch. 6): the real acrylic seed swatch (stitch-by-stitch) -> $out/seed/, shell fit in $out/seed-fit/, diagnosis in $out/seed-diagnosis/"
+sbs=../shared/data/stitch-by-stitch-acrylic
+yarnhom measure import-stitch-by-stitch "$sbs/acrylic-seed-x.h5" "$sbs/acrylic-seed-y.h5" -o "$out/seed" --every 4
+yarnhom measure check "$out/seed"
+yarnhom calibrate shell "$out/seed" -o "$out/seed-fit" --spacing 0.006
+yarnhom calibrate diagnose "$out/seed" -o "$out/seed-diagnosis" --budget quick
 echo "== done: artifacts in $out/"

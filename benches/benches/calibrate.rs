@@ -5,7 +5,7 @@
 //!
 //! Compared with: the thesis' shell fit has no published time; its yarn-level local solver took
 //! 11 min 49 s per fabric on a share of a 256-core server (Sec. 6.6). A whole shell fit is
-//! 150 to 300 of these evaluations (`yarnhom calibrate shell` prints its count and wall time).
+//! 140 to 320 of these evaluations (`yarnhom calibrate shell` prints its count and wall time).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use yarnhom_calib::measure::Direction;

@@ -1,5 +1,5 @@
 //! The real acrylic swatches of `shared/data/stitch-by-stitch-acrylic` calibrated end to end:
-//! the README's shell-fit and diagnosis tables. Heavy (about 12 minutes on 2 cores):
+//! the README's shell-fit and diagnosis tables. Heavy (about 20 minutes on 2 cores):
 //! `cargo test -p yarnhom-calib --test real_swatches -- --ignored --nocapture`.
 
 #![cfg(feature = "hdf5")]
@@ -11,7 +11,7 @@ use yarnhom_calib::stitch_by_stitch::import_fabric;
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic");
 
 #[test]
-#[ignore = "heavy: four shell fits and four diagnoses of the real swatches, about 12 minutes"]
+#[ignore = "heavy: four shell fits and four diagnoses of the real swatches, about 20 minutes"]
 fn real_acrylic_swatches_fit_and_diagnose() {
     let (mut force, mut compression) = (Vec::new(), Vec::new());
     for pattern in ["stockinette", "garter", "rib", "seed"] {
@@ -50,7 +50,7 @@ fn real_acrylic_swatches_fit_and_diagnose() {
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     eprintln!("mean: force {:.1}%, compression {:.1}%", 100.0 * mean(&force), 100.0 * mean(&compression));
     // Thesis Sec. 6.3.1 over 33 fabrics: 17.59% force, 16.84% compression. Force is met;
-    // compression is not (20.4%, README), guarded here against getting worse.
+    // compression is not (20.5%, README), guarded here against getting worse.
     assert!(mean(&force) <= 0.1759, "force error {}", mean(&force));
     assert!(mean(&compression) <= 0.22, "compression error {}", mean(&compression));
 }
