@@ -121,6 +121,8 @@ impl Pins {
 /// What the import kept and dropped in one video.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct VideoReport {
+    /// The pull direction of the video's file (`None` in a total).
+    pub direction: Option<Direction>,
     /// Video number `N` of `/videoN`: the `repeat` column.
     pub repeat: u32,
     /// Frames stored in the file.
@@ -159,7 +161,8 @@ impl Import {
 }
 
 fn video_line(v: &VideoReport) -> String {
-    format!("video{}: {}", v.repeat, report_counts(v))
+    let direction = v.direction.map_or(String::new(), |d| format!("{d} "));
+    format!("{direction}video{}: {}", v.repeat, report_counts(v))
 }
 
 fn report_counts(v: &VideoReport) -> String {
@@ -172,6 +175,7 @@ fn report_counts(v: &VideoReport) -> String {
 
 fn add_reports(a: VideoReport, b: &VideoReport) -> VideoReport {
     VideoReport {
+        direction: None,
         repeat: 0,
         frames: a.frames + b.frames,
         missing_frames: a.missing_frames + b.missing_frames,
@@ -403,6 +407,7 @@ fn convert_video(video: &Video, direction: Direction, every: usize) -> (Vec<Stre
         frames,
         missing_frames: missing_frame_count(&video.frame_numbers),
         dropped_nan: frames - finite.len(),
+        direction: Some(direction),
         ..VideoReport::default()
     };
     let (Some(&rest), Some(peak)) = (finite.first(), peak_stretch_index(video, &finite)) else {

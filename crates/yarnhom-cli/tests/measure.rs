@@ -21,7 +21,7 @@ fn import_stockinette_x_then_check() {
     let o = yarnhom(&["measure", "import-stitch-by-stitch", &input, "-o", "set"], dir.path());
     assert!(o.status.success(), "import failed: {}", text(&o.stderr));
     let report = text(&o.stderr);
-    assert!(report.contains("video5:") && report.contains("saturated"), "{report}");
+    assert!(report.contains("weft video5:") && report.contains("saturated"), "{report}");
     assert!(dir.path().join("set/fabric.toml").exists() && dir.path().join("set/stretch.csv").exists());
 
     let o = yarnhom(&["measure", "check", "set"], dir.path());
