@@ -6,7 +6,9 @@
 use nalgebra::{SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 
-use crate::forms::{RestTriangle, Stencil, forms, forms_with_derivatives};
+use crate::forms::{
+    RestTriangle, Stencil, first_form_of, first_form_with_derivatives, forms, forms_with_derivatives,
+};
 use crate::hinge::{HingeRest, anisotropic_stiffness, hinge_energy, hinge_energy_with_derivatives};
 use crate::material::ShellMaterial;
 use crate::mesh::ShellMesh;
@@ -99,6 +101,7 @@ macro_rules! psd_projection {
     };
 }
 
+psd_projection!(project_psd_9, 9);
 psd_projection!(project_psd_12, 12);
 psd_projection!(project_psd_18, 18);
 
@@ -150,9 +153,14 @@ impl ElasticModel {
         }
     }
 
-    /// The discrete forms `(I, II)` of triangle `t`.
+    /// The discrete forms `(I, II)` of triangle `t` (`II` zero for a membrane material, which
+    /// does not use it).
     pub fn triangle_forms(&self, t: usize, x: &[Vector3<f64>]) -> ([f64; 3], [f64; 3]) {
-        forms(&self.rest[t], &self.stencil(t, x))
+        if self.material.uses_second_form() {
+            forms(&self.rest[t], &self.stencil(t, x))
+        } else {
+            (first_form_of(&self.rest[t], &self.mesh.triangles[t].map(|v| x[v as usize])), [0.0; 3])
+        }
     }
 
     /// The elastic energy (J).
@@ -178,10 +186,19 @@ impl ElasticModel {
     /// Energy, gradient and, if `hessian`, the clamped Hessian, added into `out`. Elements are
     /// evaluated in parallel and summed in element order (identical for any thread count).
     pub fn assemble(&self, x: &[Vector3<f64>], hessian: bool, out: &mut Assembly) {
-        let triangles: Vec<Element<18>> =
-            (0..self.rest.len()).into_par_iter().map(|t| self.triangle_element(t, x, hessian)).collect();
-        for (t, (e, g, h)) in triangles.iter().enumerate() {
-            out.add_element(&self.stencil_vertices(t), *e, g, h.as_ref());
+        let count = self.rest.len();
+        if self.material.uses_second_form() {
+            let triangles: Vec<Element<18>> =
+                (0..count).into_par_iter().map(|t| self.triangle_element(t, x, hessian)).collect();
+            for (t, (e, g, h)) in triangles.iter().enumerate() {
+                out.add_element(&self.stencil_vertices(t), *e, g, h.as_ref());
+            }
+        } else {
+            let triangles: Vec<Element<9>> =
+                (0..count).into_par_iter().map(|t| self.membrane_element(t, x, hessian)).collect();
+            for (t, (e, g, h)) in triangles.iter().enumerate() {
+                out.add_element(&self.mesh.triangles[t].map(Some), *e, g, h.as_ref());
+            }
         }
         let hinges: Vec<Element<12>> = self
             .hinges
@@ -195,6 +212,25 @@ impl ElasticModel {
         for ((e, g, h), hinge) in hinges.iter().zip(&self.mesh.hinges) {
             out.add_element(&hinge.vertices.map(Some), *e, g, h.as_ref());
         }
+    }
+
+    /// (4.8) for a membrane material (`Ψ(I)` only) over the triangle's 9 DOFs:
+    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂I_k ∇² I_k)`, clamped to PSD.
+    fn membrane_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> Element<9> {
+        let rest = &self.rest[t];
+        let forms = first_form_with_derivatives(rest, &self.mesh.triangles[t].map(|v| x[v as usize]));
+        let jet = self.material.jet(forms.first, [0.0; 3]);
+        let dpsi = jet.gradient.fixed_rows::<3>(0).into_owned();
+        let area = rest.rest_area;
+        let gradient = area * forms.gradient.transpose() * dpsi;
+        let h = hessian.then(|| {
+            let mut h = forms.gradient.transpose() * jet.hessian.fixed_view::<3, 3>(0, 0) * forms.gradient;
+            for (k, d2i) in forms.hessian.iter().enumerate() {
+                h += dpsi[k] * d2i;
+            }
+            project_psd_9(area * h)
+        });
+        (area * jet.value, gradient, h)
     }
 
     /// (4.8) with (A.43)-(A.44), the Hessian clamped to PSD.
@@ -273,6 +309,30 @@ mod tests {
                 a.gradient[dof]
             );
         }
+    }
+
+    #[test]
+    fn the_membrane_element_is_the_stencil_element_without_its_zero_entries() {
+        // StVK ignores II: the 9-DOF path must give the 18-DOF element's energy, gradient and
+        // (unclamped, here PSD) Hessian on the triangle's DOFs, and zeros elsewhere.
+        let mesh = ShellMesh::rectangle(0.3, 0.2, 4, 3).expect("mesh");
+        let mut material = stvk();
+        material.hinge_bending = None;
+        let model = ElasticModel::new(mesh.clone(), material);
+        let x: Vec<_> =
+            mesh.material.iter().map(|m| Vector3::new(1.2 * m.x + 0.1 * m.y, 1.1 * m.y, 0.0)).collect();
+        for t in 0..mesh.triangles.len() {
+            let (e18, g18, h18) = model.triangle_element_exact(t, &x, true);
+            let (e9, g9, h9) = model.membrane_element(t, &x, true);
+            let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for"));
+            assert!((e18 - e9).abs() < 1e-15 * e18.abs().max(1.0));
+            assert!((g18.fixed_rows::<9>(0) - g9).amax() < 1e-12 * g9.amax().max(1.0));
+            assert!(g18.fixed_rows::<9>(9).amax() == 0.0);
+            assert!((h18.fixed_view::<9, 9>(0, 0) - h9).amax() < 1e-9 * h9.amax().max(1.0), "triangle {t}");
+        }
+        let mut a = Assembly::new(3 * x.len());
+        model.assemble(&x, false, &mut a);
+        assert!((a.energy - model.energy(&x)).abs() < 1e-12 * a.energy.abs().max(1.0));
     }
 
     #[test]

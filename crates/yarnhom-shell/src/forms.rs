@@ -147,13 +147,18 @@ impl FormsWithDerivatives {
         for hessian in &mut self.hessian {
             hessian.as_mut_slice().fill(0.0);
         }
-        add_first_form(self, &w, x);
+        add_first_form(self, rest, x);
         for (i, neighbour) in stencil.neighbours.iter().enumerate() {
             if let Some(far) = neighbour {
                 add_edge_term(self, &w[i], x, i, far);
             }
         }
     }
+}
+
+/// `I` of a triangle, eq. (4.6); value only.
+pub fn first_form_of(rest: &RestTriangle, triangle: &[Vec3; 3]) -> [f64; 3] {
+    first_form(&deformation_gradient(rest, triangle))
 }
 
 /// `[I11, I12, I22]` from `F`.
@@ -176,10 +181,28 @@ fn hinge_slots(i: usize) -> [usize; 4] {
     [(i + 1) % 3, (i + 2) % 3, i, 3 + i]
 }
 
+/// `I` (4.6) and its exact derivatives over the triangle's 9 DOFs: what membrane materials,
+/// which do not depend on `II`, need.
+#[derive(Clone, Debug)]
+pub struct FirstFormWithDerivatives {
+    /// `[I11, I12, I22]`.
+    pub first: [f64; 3],
+    /// Rows: `I11, I12, I22`.
+    pub gradient: SMatrix<f64, 3, 9>,
+    /// One symmetric 9×9 Hessian per row (constant in `x`).
+    pub hessian: [SMatrix<f64, 9, 9>; 3],
+}
+
 /// `I_ab = f_a · f_b` with `f_a = Σ_j w_j^a x_j`: `∂I_ab/∂x_j = w_j^a f_b + w_j^b f_a`,
 /// `∂²I_ab/∂x_j∂x_k = (w_j^a w_k^b + w_j^b w_k^a) Id₃`.
-fn add_first_form(out: &mut FormsWithDerivatives, w: &[Vector2<f64>; 3], x: &[Vec3; 3]) {
+pub fn first_form_with_derivatives(rest: &RestTriangle, x: &[Vec3; 3]) -> FirstFormWithDerivatives {
+    let w = rest.barycentric_gradients();
     let f = [0, 1].map(|a| (0..3).map(|j| x[j] * w[j][a]).sum::<Vec3>());
+    let mut out = FirstFormWithDerivatives {
+        first: [0.0; 3],
+        gradient: SMatrix::zeros(),
+        hessian: [SMatrix::zeros(); 3],
+    };
     for (row, &(a, b)) in FORM_ENTRIES.iter().enumerate() {
         out.first[row] = f[a].dot(&f[b]);
         for j in 0..3 {
@@ -190,6 +213,18 @@ fn add_first_form(out: &mut FormsWithDerivatives, w: &[Vector2<f64>; 3], x: &[Ve
                 out.hessian[row].fixed_view_mut::<3, 3>(3 * j, 3 * k).fill_diagonal(coefficient);
             }
         }
+    }
+    out
+}
+
+/// The first form's rows of [`FormsWithDerivatives`]: the triangle's DOFs are the stencil's
+/// first 9.
+fn add_first_form(out: &mut FormsWithDerivatives, rest: &RestTriangle, x: &[Vec3; 3]) {
+    let first = first_form_with_derivatives(rest, x);
+    out.first = first.first;
+    out.gradient.fixed_view_mut::<3, 9>(0, 0).copy_from(&first.gradient);
+    for (hessian, block) in out.hessian.iter_mut().zip(&first.hessian) {
+        hessian.fixed_view_mut::<9, 9>(0, 0).copy_from(block);
     }
 }
 
