@@ -1,6 +1,6 @@
 //! The real acrylic swatches of `shared/data/stitch-by-stitch-acrylic` calibrated end to end:
-//! the README's shell-fit and diagnosis tables. Heavy (about 20 minutes on 2 cores):
-//! `cargo test -p yarnhom-calib --test real_swatches -- --ignored --nocapture`.
+//! the README's shell-fit and diagnosis tables (about 100 s on 2 cores; `-- --nocapture`
+//! prints them).
 
 #![cfg(feature = "hdf5")]
 
@@ -11,7 +11,6 @@ use yarnhom_calib::stitch_by_stitch::import_fabric;
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic");
 
 #[test]
-#[ignore = "heavy: four shell fits and four diagnoses of the real swatches, about 20 minutes"]
 fn real_acrylic_swatches_fit_and_diagnose() {
     let (mut force, mut compression) = (Vec::new(), Vec::new());
     for pattern in ["stockinette", "garter", "rib", "seed"] {
