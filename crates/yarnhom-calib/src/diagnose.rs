@@ -37,7 +37,7 @@ use yarnhom_shell::{Stiffening, StvkNeoHookean};
 use crate::lm::LmSettings;
 use crate::measure::{Direction, MeasurementSet, Phase};
 use crate::shell_fit::{
-    DirectionData, Parameterization, Problem, ShellFitError, Terms, forces_and_compressions,
+    DirectionData, Parameterization, Problem, ShellFitError, Terms, forces_and_compressions, rms,
     starting_material,
 };
 use crate::swatch::SimulatedReading;
@@ -272,10 +272,6 @@ fn residuals(
         add(u, unload, unload_factor);
     }
     (fitted, heldout)
-}
-
-fn rms(r: &[f64]) -> f64 {
-    (r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64).sqrt()
 }
 
 fn criterion(r: &[f64], parameters: usize) -> f64 {

@@ -283,19 +283,18 @@ impl DirectionData {
 
     /// Force and compression errors (Sec. 6.3.1) over the targets whose `fitted` flag is `which`.
     fn errors(&self, forces: &[f64], compressions: &[f64], which: bool) -> (f64, Option<f64>) {
-        let rms = |d: Vec<f64>| (d.iter().map(|x| x * x).sum::<f64>() / d.len().max(1) as f64).sqrt();
         let chosen =
             || self.targets.iter().zip(&self.fitted).filter(move |(_, f)| **f == which).map(|(t, _)| t);
         let picked = |values: &[f64]| -> Vec<f64> {
             values.iter().zip(&self.fitted).filter(|(_, f)| **f == which).map(|(v, _)| *v).collect()
         };
-        let force =
-            rms(chosen().zip(picked(forces)).map(|(t, f)| f - t.force_n).collect()) / self.force_scale;
+        let force = rms(&chosen().zip(picked(forces)).map(|(t, f)| f - t.force_n).collect::<Vec<_>>())
+            / self.force_scale;
         let compression = self.compression_scale.map(|scale| {
-            rms(chosen()
+            rms(&chosen()
                 .zip(picked(compressions))
                 .filter_map(|(t, c)| t.compression.map(|m| c - m))
-                .collect())
+                .collect::<Vec<_>>())
                 / scale
         });
         (force, compression)
@@ -311,6 +310,11 @@ impl DirectionData {
             })
             .unzip()
     }
+}
+
+/// Root mean square (0 for no values).
+pub(crate) fn rms(values: &[f64]) -> f64 {
+    (values.iter().map(|x| x * x).sum::<f64>() / values.len().max(1) as f64).sqrt()
 }
 
 pub(crate) fn forces_and_compressions(readings: &[SimulatedReading]) -> (Vec<f64>, Vec<f64>) {
