@@ -12,12 +12,17 @@ pub mod pear_loop;
 pub mod shell_fit;
 #[cfg(feature = "hdf5")]
 pub mod stitch_by_stitch;
+pub mod swarm;
 pub mod swatch;
 pub mod synth;
 pub mod targets;
 #[cfg(test)]
 mod test_support;
 pub mod uniform;
+pub mod yarn_fit;
+pub mod yarn_objective;
+pub mod yarn_params;
+pub mod yarn_tile;
 
 pub use measure::{
     BendingPoint, Direction, Fabric, MeasureError, MeasurementSet, Phase, Specimen, StretchPoint, Swatch,

@@ -39,7 +39,7 @@ pub struct UniaxialPoint {
 
 /// The first fundamental form `I = Fᵀ F` of `F = (1 + s) u uᵀ + (1 - c) v vᵀ`, as
 /// `(I11, I12, I22)`.
-fn first_form(u: Vector2<f64>, stretch: f64, compression: f64) -> [f64; 3] {
+pub(crate) fn first_form(u: Vector2<f64>, stretch: f64, compression: f64) -> [f64; 3] {
     let (a, b) = ((1.0 + stretch).powi(2), (1.0 - compression).powi(2));
     let v = Vector2::new(-u.y, u.x);
     [a * u.x * u.x + b * v.x * v.x, a * u.x * u.y + b * v.x * v.y, a * u.y * u.y + b * v.y * v.y]

@@ -92,15 +92,7 @@ impl YarnNeighbours {
 /// for a pattern with no such pair.
 pub fn min_inter_yarn_distance(pattern: &Pattern) -> Option<MinDistance> {
     let neighbours = YarnNeighbours::new(pattern);
-    let segments: Vec<Segment> = pattern
-        .edges()
-        .map(|e| Segment {
-            edge: EdgeRef { yarn: e.yarn, index: e.index_in_yarn },
-            from: e.from,
-            p0: Vector3::from(pattern.positions_m[e.from as usize]),
-            p1: Vector3::from(pattern.shifted(e.to, e.offset)),
-        })
-        .collect();
+    let segments = segments_of(pattern);
     let nearest = closest_within_images(pattern, &neighbours, &segments, [1, 1])?;
     let reach = images_within(pattern, &segments, nearest.distance_m);
     if reach[0] > 1 || reach[1] > 1 {
@@ -108,6 +100,51 @@ pub fn min_inter_yarn_distance(pattern: &Pattern) -> Option<MinDistance> {
     } else {
         Some(nearest)
     }
+}
+
+/// Per edge (indexed by source vertex): the centreline distance to the nearest edge that is not
+/// its neighbour along a yarn, over the tile and its images within reach. The largest of these is
+/// the smallest radius at which every edge touches another (`R_est` of thesis Sec. 6.5.3).
+pub fn edge_clearances(pattern: &Pattern) -> Vec<f64> {
+    let neighbours = YarnNeighbours::new(pattern);
+    let segments = segments_of(pattern);
+    // Every edge has another within a period of it (its own images at the latest).
+    let reach = images_within(pattern, &segments, pattern.period_m[0].max(pattern.period_m[1]));
+    let mut clearance = vec![f64::INFINITY; pattern.vertex_count()];
+    for ox in -reach[0]..=reach[0] {
+        for oy in -reach[1]..=reach[1] {
+            let shift =
+                Vector3::new(f64::from(ox) * pattern.period_m[0], f64::from(oy) * pattern.period_m[1], 0.0);
+            for a in &segments {
+                for b in &segments {
+                    let (b0, b1) = (b.p0 + shift, b.p1 + shift);
+                    let bound = clearance[a.from as usize];
+                    if lower_bound(&a.p0, &a.p1, &b0, &b1) >= bound
+                        || (ox == 0 && oy == 0 && a.from == b.from)
+                        || neighbours.are_neighbours(a.from, b.from, [ox, oy])
+                    {
+                        continue;
+                    }
+                    let d = segment_distance(&a.p0, &a.p1, &b0, &b1).distance;
+                    clearance[a.from as usize] = bound.min(d);
+                }
+            }
+        }
+    }
+    clearance
+}
+
+/// The tile's edges as segments.
+fn segments_of(pattern: &Pattern) -> Vec<Segment> {
+    pattern
+        .edges()
+        .map(|e| Segment {
+            edge: EdgeRef { yarn: e.yarn, index: e.index_in_yarn },
+            from: e.from,
+            p0: Vector3::from(pattern.positions_m[e.from as usize]),
+            p1: Vector3::from(pattern.shifted(e.to, e.offset)),
+        })
+        .collect()
 }
 
 /// An edge with its end points (the end shifted by the edge's tile offset).

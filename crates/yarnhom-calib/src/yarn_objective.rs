@@ -1,0 +1,270 @@
+//! The objective of the yarn-level estimation (thesis Sec. 6.5.3, (6.11)): the uniform targets
+//! `{s, c, σ_s}` of the fitted shell against the periodic yarn tile under the same stretches.
+//!
+//! - Stretch errors are in the second Piola-Kirchhoff stress `σ_s / (1 + s)`, compression errors
+//!   in `c`; each normalized by its largest target in the comfort range (stretches whose clamp
+//!   force stays under 2 N, Sec. 6.2.3) and weighted by `v_comfort / max(v_comfort, v_target)`,
+//!   which is 1 in the comfort range and decays beyond it.
+//! - The tile's compression of zero orthogonal stress is found at both ends of the stretch range
+//!   and linearly interpolated in between, as the thesis does (it also smooths the buckling noise
+//!   near the optimal compression).
+//! - Compressions are normalized by at least [`COMPRESSION_FLOOR`]: a fabric that barely narrows
+//!   in the comfort range (the stockinette's weft: 0.3% at 2 N) would otherwise turn measurement
+//!   noise into a dominant error.
+
+use rayon::prelude::*;
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+use yarnhom_rve::RveModel;
+use yarnhom_rve::assembly::RveState;
+use yarnhom_shell::StvkNeoHookean;
+
+use crate::measure::Direction;
+use crate::uniform::uniaxial;
+use crate::yarn_tile::{TileError, TileSample, solve_uniaxial, zero_orthogonal_stress};
+
+/// Smallest normalization of compression errors.
+pub const COMPRESSION_FLOOR: f64 = 0.02;
+
+/// The clamp force bounding the comfort range (N, Sec. 6.2.3).
+pub const COMFORT_FORCE_N: f64 = 2.0;
+
+/// The uniform targets of one direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct DirectionTargets {
+    /// Direction.
+    pub direction: Direction,
+    /// Largest stretch of the comfort range.
+    pub comfort_stretch: f64,
+    /// Target stretches (increasing).
+    pub stretch: Vec<f64>,
+    /// Target compressions.
+    pub compression: Vec<f64>,
+    /// Target stretch stresses `σ_s` (N/m).
+    pub stress_n_m: Vec<f64>,
+    /// `v_comfort` of the stretch errors: the second Piola-Kirchhoff stress at the comfort
+    /// stretch (N/m); also their normalization.
+    pub comfort_stress_n_m: f64,
+    /// `v_comfort` of the compression errors.
+    pub comfort_compression: f64,
+}
+
+impl DirectionTargets {
+    /// `n` targets of the shell `material` along `direction`, evenly up to `max_stretch`; the
+    /// comfort range ends where the clamp force `σ_s w` of a swatch of width `width_m` reaches
+    /// `comfort_force_n`.
+    pub fn of_shell(
+        material: &StvkNeoHookean,
+        direction: Direction,
+        max_stretch: f64,
+        width_m: f64,
+        n: usize,
+        comfort_force_n: f64,
+    ) -> Self {
+        let force = |s: f64| uniaxial(material, direction, s).stress_n_m * width_m;
+        let comfort_stretch = if force(max_stretch) <= comfort_force_n {
+            max_stretch
+        } else {
+            let (mut lo, mut hi) = (0.0, max_stretch);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if force(mid) < comfort_force_n { lo = mid } else { hi = mid }
+            }
+            0.5 * (lo + hi)
+        };
+        let points: Vec<_> =
+            (1..=n).map(|i| uniaxial(material, direction, max_stretch * i as f64 / n as f64)).collect();
+        let at_comfort = uniaxial(material, direction, comfort_stretch);
+        DirectionTargets {
+            direction,
+            comfort_stretch,
+            stretch: points.iter().map(|p| p.stretch).collect(),
+            compression: points.iter().map(|p| p.compression).collect(),
+            stress_n_m: points.iter().map(|p| p.stress_n_m).collect(),
+            comfort_stress_n_m: at_comfort.stress_n_m / (1.0 + comfort_stretch),
+            comfort_compression: at_comfort.compression,
+        }
+    }
+
+    /// The weights `v_comfort / max(v_comfort, v)` of the stretch and compression errors at
+    /// target `i`.
+    fn weights(&self, i: usize) -> (f64, f64) {
+        let decay = |comfort: f64, v: f64| if comfort > 0.0 { comfort / comfort.max(v) } else { 1.0 };
+        (
+            decay(self.comfort_stress_n_m, self.stress_n_m[i] / (1.0 + self.stretch[i])),
+            decay(self.comfort_compression, self.compression[i]),
+        )
+    }
+
+    /// Normalization of compression errors.
+    fn compression_scale(&self) -> f64 {
+        self.comfort_compression.max(COMPRESSION_FLOOR)
+    }
+}
+
+/// The tile's response at the targets of one direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct SimulatedCurve {
+    /// Direction.
+    pub direction: Direction,
+    /// Stretches (the targets').
+    pub stretch: Vec<f64>,
+    /// Compressions: of zero orthogonal stress at both ends, interpolated in between.
+    pub compression: Vec<f64>,
+    /// Stretch stresses `σ_s` (N/m), (6.10).
+    pub stress_n_m: Vec<f64>,
+    /// Newton iterations of all solves.
+    pub iterations: usize,
+}
+
+/// Simulate the tile (with its zero-strain equilibrium `rest`) at the stretches of `targets`:
+/// the compressions of zero orthogonal stress at the first and last stretch (marching between
+/// them by warm-started solves at the last compression), then every stretch at the interpolated compression,
+/// warm-started from the march.
+pub fn simulate_direction(
+    tile: &RveModel,
+    rest: &RveState,
+    targets: &DirectionTargets,
+) -> Result<SimulatedCurve, TileError> {
+    let (direction, s) = (targets.direction, &targets.stretch);
+    let n = s.len();
+    let first = zero_orthogonal_stress(tile, direction, s[0], 0.0, Some(rest))?;
+    let mut iterations = first.iterations;
+    let mut march: Vec<TileSample> = vec![first];
+    for i in 1..n {
+        let previous = &march[i - 1];
+        let sample = if i + 1 == n {
+            zero_orthogonal_stress(tile, direction, s[i], previous.compression, Some(&previous.state))?
+        } else {
+            solve_uniaxial(tile, direction, s[i], previous.compression, Some(&previous.state))?
+        };
+        iterations += sample.iterations;
+        march.push(sample);
+    }
+    let (c0, c1) = (march[0].compression, march[n - 1].compression);
+    let interpolated =
+        |i: usize| if n == 1 { c0 } else { c0 + (c1 - c0) * (s[i] - s[0]) / (s[n - 1] - s[0]) };
+    let mut curve = SimulatedCurve {
+        direction,
+        stretch: s.clone(),
+        compression: Vec::with_capacity(n),
+        stress_n_m: Vec::with_capacity(n),
+        iterations,
+    };
+    for (i, marched) in march.iter().enumerate() {
+        let sample = if i == 0 || i + 1 == n {
+            marched.clone()
+        } else {
+            let sample = solve_uniaxial(tile, direction, s[i], interpolated(i), Some(&marched.state))?;
+            curve.iterations += sample.iterations;
+            sample
+        };
+        curve.compression.push(sample.compression);
+        curve.stress_n_m.push(sample.stretch_stress_n_m);
+    }
+    Ok(curve)
+}
+
+/// [`simulate_direction`] for every direction, in parallel.
+pub fn simulate(
+    tile: &RveModel,
+    rest: &RveState,
+    targets: &[DirectionTargets],
+) -> Result<Vec<SimulatedCurve>, TileError> {
+    targets.par_iter().map(|t| simulate_direction(tile, rest, t)).collect()
+}
+
+/// The residuals of (6.11) (`g = Σ r²`): per direction, the weighted, normalized stretch errors,
+/// then the compression errors.
+pub fn residuals(targets: &[DirectionTargets], curves: &[SimulatedCurve]) -> Vec<f64> {
+    let mut r = Vec::new();
+    for (t, c) in targets.iter().zip(curves) {
+        for i in 0..t.stretch.len() {
+            let (ws, wc) = t.weights(i);
+            let pk2 = |sigma: f64| sigma / (1.0 + t.stretch[i]);
+            r.push(ws * (pk2(c.stress_n_m[i]) - pk2(t.stress_n_m[i])) / t.comfort_stress_n_m);
+            r.push(wc * (c.compression[i] - t.compression[i]) / t.compression_scale());
+        }
+    }
+    r
+}
+
+/// Errors of a yarn-level fit (fractions, as Fig. 6.15: relative to the largest target in the
+/// comfort range).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct YarnErrors {
+    /// Direction.
+    pub direction: Direction,
+    /// RMS stretch-stress error over the comfort range.
+    pub comfort_stress: f64,
+    /// RMS stretch-stress error beyond it (absent if every target is within it).
+    pub power_stress: Option<f64>,
+    /// RMS compression error over all targets.
+    pub compression: f64,
+}
+
+/// The errors of `curves` against `targets`, per direction.
+pub fn errors(targets: &[DirectionTargets], curves: &[SimulatedCurve]) -> Vec<YarnErrors> {
+    let rms =
+        |v: &[f64]| (!v.is_empty()).then(|| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt());
+    targets
+        .iter()
+        .zip(curves)
+        .map(|(t, c)| {
+            let (mut comfort, mut power, mut compression) = (Vec::new(), Vec::new(), Vec::new());
+            for i in 0..t.stretch.len() {
+                let e = (c.stress_n_m[i] - t.stress_n_m[i]) / (1.0 + t.stretch[i]) / t.comfort_stress_n_m;
+                if t.stretch[i] <= t.comfort_stretch * (1.0 + 1e-9) {
+                    comfort.push(e)
+                } else {
+                    power.push(e)
+                }
+                compression.push((c.compression[i] - t.compression[i]) / t.compression_scale());
+            }
+            YarnErrors {
+                direction: t.direction,
+                comfort_stress: rms(&comfort).unwrap_or(0.0),
+                power_stress: rms(&power),
+                compression: rms(&compression).unwrap_or(0.0),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_support::knit_membrane;
+
+    #[test]
+    fn comfort_ends_at_two_newtons_and_weights_decay_past_it() {
+        let t = DirectionTargets::of_shell(&knit_membrane(), Direction::Weft, 0.6, 0.06, 12, COMFORT_FORCE_N);
+        let force = uniaxial(&knit_membrane(), Direction::Weft, t.comfort_stretch).stress_n_m * 0.06;
+        assert!((force - COMFORT_FORCE_N).abs() < 1e-6, "{force}");
+        for i in 0..t.stretch.len() {
+            let (ws, _) = t.weights(i);
+            if t.stretch[i] <= t.comfort_stretch {
+                assert_eq!(ws, 1.0);
+            } else {
+                assert!(ws < 1.0 && ws > 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn a_curve_equal_to_its_targets_has_no_residual() {
+        let t = DirectionTargets::of_shell(&knit_membrane(), Direction::Bias, 0.4, 0.06, 5, COMFORT_FORCE_N);
+        let curve = SimulatedCurve {
+            direction: t.direction,
+            stretch: t.stretch.clone(),
+            compression: t.compression.clone(),
+            stress_n_m: t.stress_n_m.clone(),
+            iterations: 0,
+        };
+        assert!(residuals(std::slice::from_ref(&t), std::slice::from_ref(&curve)).iter().all(|r| *r == 0.0));
+        let mut off = curve.clone();
+        off.stress_n_m.iter_mut().for_each(|s| *s *= 1.1);
+        let e = &errors(std::slice::from_ref(&t), &[off])[0];
+        assert!(e.comfort_stress > 0.0 && e.compression == 0.0);
+    }
+}
