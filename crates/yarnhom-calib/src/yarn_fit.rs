@@ -100,16 +100,26 @@ pub enum YarnFitError {
     NothingEvaluable(usize),
 }
 
-/// The estimation problem: the input geometry, the fixed quantities, and the shell's uniform
-/// targets along the tested directions.
+/// Where the targets come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TargetSource {
+    /// The uniform tests of a fitted shell (6.3): the thesis' route from measurements.
+    Shell(StvkNeoHookean),
+    /// The tile itself at a known search point: a ground truth that the estimation must
+    /// recover (identifiability and optimizer checks).
+    Yarn(Vec<f64>),
+}
+
+/// The estimation problem: the input geometry, the fixed quantities, and the uniform targets
+/// along the tested directions.
 #[derive(Debug, Clone)]
 pub struct YarnProblem {
     /// Input yarn geometry (generated or registered).
     pub pattern: Pattern,
     /// Fixed quantities.
     pub basis: YarnBasis,
-    /// The fitted shell (6.1).
-    pub material: StvkNeoHookean,
+    /// The targets' origin.
+    pub source: TargetSource,
     /// Tested directions: `(direction, largest tested stretch, swatch width in m)`.
     pub directions: Vec<(Direction, f64, f64)>,
     /// Rest-shape estimation.
@@ -156,19 +166,43 @@ impl YarnProblem {
         Ok(YarnProblem {
             pattern,
             basis,
-            material: shell.material,
+            source: TargetSource::Shell(shell.material),
             directions,
             rest: settings.rest,
             comfort_force_n: settings.comfort_force_n,
         })
     }
 
-    /// `n` targets per tested direction.
-    pub fn targets(&self, n: usize) -> Vec<DirectionTargets> {
-        self.directions
-            .iter()
-            .map(|&(d, s, w)| DirectionTargets::of_shell(&self.material, d, s, w, n, self.comfort_force_n))
-            .collect()
+    /// `n` targets per tested direction, evenly spaced in stretch.
+    pub fn targets(&self, n: usize) -> Result<Vec<DirectionTargets>, YarnFitError> {
+        match &self.source {
+            TargetSource::Shell(material) => Ok(self
+                .directions
+                .iter()
+                .map(|&(d, s, w)| DirectionTargets::of_shell(material, d, s, w, n, self.comfort_force_n))
+                .collect()),
+            TargetSource::Yarn(truth) => {
+                let stretches: Vec<DirectionTargets> = self
+                    .directions
+                    .iter()
+                    .map(|&(direction, s_max, _)| DirectionTargets {
+                        direction,
+                        comfort_stretch: s_max,
+                        stretch: (1..=n).map(|i| s_max * i as f64 / n as f64).collect(),
+                        compression: vec![0.0; n],
+                        stress_n_m: vec![0.0; n],
+                        comfort_stress_n_m: 1.0,
+                        comfort_compression: 0.0,
+                    })
+                    .collect();
+                let curves = self.evaluate(truth, &stretches)?.curves;
+                Ok(curves
+                    .iter()
+                    .zip(&self.directions)
+                    .map(|(c, &(_, _, w))| DirectionTargets::of_curve(c, w, self.comfort_force_n))
+                    .collect())
+            }
+        }
     }
 
     /// The yarn model at search point `x`.
@@ -303,7 +337,7 @@ pub fn fit_yarn(
     let (swarm_report, mut x) = match start {
         Some(x) => (None, problem.clamped(x)),
         None => {
-            let coarse = problem.targets(settings.swarm_targets);
+            let coarse = problem.targets(settings.swarm_targets)?;
             let report = swarm(
                 |x| problem.evaluate(x, &coarse).ok().map(|e| e.cost),
                 &bounds,
@@ -317,7 +351,7 @@ pub fn fit_yarn(
             (Some(report), best)
         }
     };
-    let targets = problem.targets(settings.local_targets);
+    let targets = problem.targets(settings.local_targets)?;
     let local = match settings.local {
         LocalSolver::None => None,
         solver => {

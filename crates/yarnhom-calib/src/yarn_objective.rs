@@ -86,6 +86,34 @@ impl DirectionTargets {
         }
     }
 
+    /// Targets read off a simulated curve (a yarn model as ground truth); the comfort range ends
+    /// where the clamp force `σ_s w` of a swatch of width `width_m` reaches `comfort_force_n`
+    /// (linear interpolation between the curve's points).
+    pub fn of_curve(curve: &SimulatedCurve, width_m: f64, comfort_force_n: f64) -> Self {
+        let (s, c, sigma) = (&curve.stretch, &curve.compression, &curve.stress_n_m);
+        let n = s.len();
+        let limit = comfort_force_n / width_m;
+        let comfort_stretch = match (0..n).find(|&i| sigma[i] >= limit) {
+            None => s[n - 1],
+            Some(0) => s[0] * limit / sigma[0].max(f64::MIN_POSITIVE),
+            Some(i) => s[i - 1] + (s[i] - s[i - 1]) * (limit - sigma[i - 1]) / (sigma[i] - sigma[i - 1]),
+        };
+        let at = |v: &[f64]| {
+            let i = s.iter().position(|&x| x >= comfort_stretch).unwrap_or(n - 1).max(1).min(n - 1);
+            let t = ((comfort_stretch - s[i - 1]) / (s[i] - s[i - 1])).clamp(0.0, 1.0);
+            if n == 1 { v[0] } else { v[i - 1] + t * (v[i] - v[i - 1]) }
+        };
+        DirectionTargets {
+            direction: curve.direction,
+            comfort_stretch,
+            stretch: s.clone(),
+            compression: c.clone(),
+            stress_n_m: sigma.clone(),
+            comfort_stress_n_m: at(sigma) / (1.0 + comfort_stretch),
+            comfort_compression: at(c),
+        }
+    }
+
     /// The weights `v_comfort / max(v_comfort, v)` of the stretch and compression errors at
     /// target `i`.
     fn weights(&self, i: usize) -> (f64, f64) {

@@ -38,6 +38,11 @@ pub enum CalibrateCommand {
     /// membrane and hinge bending (6.4) clamped into a loop at each clamp distance; print the
     /// loop's height, width and aspect ratio (to choose distances where the test is sensitive).
     PearLoop(PearLoopArgs),
+    /// Estimate the Ch. 6 yarn model (Sec. 6.5) whose periodic tile reproduces the fitted
+    /// shell's uniform targets: particle swarm, then COBYLA or Levenberg-Marquardt, the yarns'
+    /// rest shape re-estimated at every evaluation; write OUT/yarn-fit.json, the estimated
+    /// OUT/yarn.yarnmodel.yh and OUT/rest.pattern.yh, and OUT/yarn-fit.svg (Fig. 6.13 style).
+    Yarn(crate::calibrate_yarn::YarnArgs),
 }
 
 #[derive(Debug, Args)]
@@ -169,6 +174,7 @@ pub fn run(cmd: CalibrateCommand) -> Result<Outcome> {
         CalibrateCommand::Diagnose(args) => diagnose_command(args),
         CalibrateCommand::Synth(args) => synth(args),
         CalibrateCommand::PearLoop(args) => pear_loop(args),
+        CalibrateCommand::Yarn(args) => crate::calibrate_yarn::run(args),
     }
 }
 
@@ -471,15 +477,15 @@ fn summary(fit: &ShellFit) -> String {
     lines.join("\n")
 }
 
-const MEASURED: RGBColor = RGBColor(0xB0, 0xB8, 0xC8);
-const TARGET: RGBColor = RGBColor(0x1F, 0x5F, 0xD0);
-const FITTED: RGBColor = RGBColor(0xC0, 0x30, 0x30);
-const UNIFORM: RGBColor = RGBColor(0x1A, 0x9A, 0x3A);
+pub(crate) const MEASURED: RGBColor = RGBColor(0xB0, 0xB8, 0xC8);
+pub(crate) const TARGET: RGBColor = RGBColor(0x1F, 0x5F, 0xD0);
+pub(crate) const FITTED: RGBColor = RGBColor(0xC0, 0x30, 0x30);
+pub(crate) const UNIFORM: RGBColor = RGBColor(0x1A, 0x9A, 0x3A);
 const UNLOAD: RGBColor = RGBColor(0xE0, 0x90, 0x20);
 
 /// How a series is drawn.
 #[derive(Clone, Copy)]
-enum Mark {
+pub(crate) enum Mark {
     /// Small filled dots (raw readings).
     Speck(RGBColor),
     /// Filled circles.
@@ -492,21 +498,21 @@ enum Mark {
     Line(RGBColor),
 }
 
-struct Series {
-    label: String,
-    mark: Mark,
-    points: Vec<(f64, f64)>,
+pub(crate) struct Series {
+    pub label: String,
+    pub mark: Mark,
+    pub points: Vec<(f64, f64)>,
 }
 
 /// One chart of a figure: y against stretch.
-struct Panel {
-    title: String,
-    y_label: String,
-    series: Vec<Series>,
+pub(crate) struct Panel {
+    pub title: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
 }
 
 /// Draw `panels` in a grid of `columns` (row-major) as an SVG string.
-fn plot_panels(panels: &[Panel], columns: usize) -> Result<String> {
+pub(crate) fn plot_panels(panels: &[Panel], columns: usize) -> Result<String> {
     let rows = panels.len().div_ceil(columns.max(1));
     let size = (420 * columns as u32, 380 * rows as u32);
     render(size, |root| {

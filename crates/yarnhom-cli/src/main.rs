@@ -5,6 +5,7 @@
 //! 1 "different" for `diff`, 2 any error (bad input, unreadable file, usage).
 
 mod calibrate;
+mod calibrate_yarn;
 mod convert;
 mod diff;
 mod fit;

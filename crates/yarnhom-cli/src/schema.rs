@@ -13,7 +13,8 @@ pub struct SchemaArgs {
     #[arg(required_unless_present = "write_all")]
     pub kind: Option<String>,
     /// Write the current schema of every kind as DIR/KIND.vN.schema.json, of the calibration
-    /// reports as DIR/shell-fit.vN.schema.json and DIR/diagnosis.vN.schema.json, and of every trace topic as
+    /// reports as DIR/shell-fit.vN.schema.json, DIR/diagnosis.vN.schema.json and
+    /// DIR/yarn-fit.vN.schema.json, and of every trace topic as
     /// DIR/trace/SCHEMA_NAME.schema.json (how the committed `schemas/` folder is made).
     #[arg(long, value_name = "DIR", conflicts_with = "kind")]
     pub write_all: Option<PathBuf>,
@@ -37,6 +38,11 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
                 "diagnosis",
                 yarnhom_calib::diagnose::DIAGNOSIS_VERSION,
                 yarnhom_calib::diagnose::diagnosis_schema(),
+            ),
+            (
+                "yarn-fit",
+                yarnhom_calib::yarn_fit::YARN_FIT_VERSION,
+                yarnhom_calib::yarn_fit::yarn_fit_schema(),
             ),
         ];
         for (name, version, schema) in reports {

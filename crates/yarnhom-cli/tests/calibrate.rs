@@ -140,3 +140,59 @@ fn pear_loop_prints_a_loop_per_clamp_distance_and_refuses_impossible_ones() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("does not form a loop"), "{}", text(&o.stderr));
 }
+
+#[test]
+fn calibrate_yarn_estimates_a_yarn_model_in_shards_and_writes_its_artifacts() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let plan = SynthPlan {
+        directions: vec![Direction::Weft, Direction::Warp],
+        max_stretch: vec![0.4, 0.4],
+        spacing_m: 0.01,
+        ..SynthPlan::new("synthetic", 0.3)
+    };
+    let truth = StvkNeoHookean {
+        k_xx: 80.0,
+        k_xy: 10.0,
+        k_yy: 30.0,
+        k_ss: 12.0,
+        k_n1: 3.0,
+        k_n2: 1.0,
+        stiffening: None,
+    };
+    synthesize(&truth, &plan).expect("simulates").write(&dir.path().join("set")).expect("writes");
+    let small =
+        ["--generations", "1", "--swarm-targets", "3", "--local-targets", "3", "--yarn-stiffness", "200"];
+    // Two shards of a 4-particle swarm, then the local step from the better one.
+    for shard in ["0/2", "1/2"] {
+        let out = format!("shard{}", &shard[..1]);
+        let mut args = vec!["calibrate", "yarn", "set", "-o", &out, "--particles", "4", "--shard", shard];
+        args.extend(small);
+        let o = yarnhom(&args, dir.path());
+        assert!(o.status.success(), "{}", text(&o.stderr));
+    }
+    let mut args = vec!["calibrate", "yarn", "set", "-o", "out", "--budget", "3"];
+    args.extend(small);
+    args.extend(["--start-from", "shard0/yarn-fit.json", "shard1/yarn-fit.json"]);
+    let o = yarnhom(&args, dir.path());
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let summary = text(&o.stdout);
+    for expected in ["comfort stress", "weft", "warp", "local (Cobyla)"] {
+        assert!(summary.contains(expected), "missing '{expected}' in:\n{summary}");
+    }
+    let fit: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/yarn-fit.json")).expect("json"))
+            .expect("parses");
+    assert_eq!(fit["format"], "yarnhom.yarn-fit");
+    assert_eq!(fit["params"]["k_s2_n"], 200.0);
+    assert!(fit["swarm"].is_null(), "the local step started from the shards");
+    for file in ["yarn.yarnmodel.yh", "rest.pattern.yh", "yarn-fit.svg", "shell-fit.json"] {
+        assert!(dir.path().join("out").join(file).is_file(), "{file}");
+    }
+    let o = yarnhom(&["inspect", "out/yarn.yarnmodel.yh"], dir.path());
+    assert!(text(&o.stdout).contains("biphasic"), "{}", text(&o.stdout));
+    let o = yarnhom(&["calibrate", "yarn", "set", "-o", "x", "--shard", "2/2"], dir.path());
+    assert_eq!(o.status.code(), Some(2));
+    assert!(text(&o.stderr).contains("need 0 <= K < N"), "{}", text(&o.stderr));
+    let o = yarnhom(&["calibrate", "yarn", "set", "-o", "x", "--yarn-stiffness=-1"], dir.path());
+    assert!(text(&o.stderr).contains("--yarn-stiffness must be a positive"), "{}", text(&o.stderr));
+}

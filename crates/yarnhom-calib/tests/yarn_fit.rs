@@ -1,0 +1,129 @@
+//! Yarn-level estimation (thesis Sec. 6.5) on the generated stockinette tile: the stress (6.10)
+//! and the zero-orthogonal-stress compression on a real tile, and recovery of a hidden yarn
+//! model by the local optimizers.
+
+use yarnhom_artifacts::Pattern;
+use yarnhom_calib::Direction;
+use yarnhom_calib::swarm::SwarmSettings;
+use yarnhom_calib::yarn_fit::{
+    LocalSolver, RestShapeSettings, TargetSource, YarnFitSettings, YarnProblem, fit_yarn,
+};
+use yarnhom_calib::yarn_objective::{COMFORT_FORCE_N, residuals};
+use yarnhom_calib::yarn_params::YarnBasis;
+use yarnhom_calib::yarn_tile::{solve_uniaxial, zero_orthogonal_stress};
+use yarnhom_geom::MacroStrain;
+use yarnhom_rve::homogenize::solve_at;
+use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, relax};
+
+fn stockinette() -> Pattern {
+    let params = yarnhom_pattern::GeneratorParams::defaults_for("stockinette").expect("built in");
+    yarnhom_pattern::generate("stockinette", &params).expect("generates")
+}
+
+/// A hidden yarn model. The generated stockinette is slack up to about 20% stretch, then
+/// stiffens as its yarns go taut (a J curve, 0.1 to 100 N/m over 8-50% weft stretch).
+const TRUTH: [f64; 5] = [-0.5, 0.05, 0.5, 1.0, 0.0];
+
+fn basis(pattern: &Pattern) -> YarnBasis {
+    YarnBasis::of_pattern(pattern, Some(200.0), 1180.0)
+}
+
+/// The rest-estimated tile of the hidden model and its zero-strain equilibrium.
+fn truth_tile() -> (RveModel, yarnhom_rve::assembly::RveState) {
+    let pattern = stockinette();
+    let basis = basis(&pattern);
+    let model = basis.params(&TRUTH).model("truth", &basis);
+    let options = RelaxOptions {
+        method: RelaxMethod::Estimation { max_length_change: 0.2 },
+        max_resets: 8,
+        ..RelaxOptions::default()
+    };
+    let (rest, _) = relax(&pattern, &model, &options, &mut |_| {}).expect("rest shape");
+    let tile = RveModel::new(&rest, &model).expect("tile");
+    let zero = MacroStrain::new(0.0, 0.0, 0.0, 0.0, 0.0).expect("valid");
+    let (report, state) = solve_at(&tile, &zero, None, &SolveOptions::default());
+    assert!(report.converged);
+    (tile, state)
+}
+
+#[test]
+fn the_stretch_stress_is_the_energy_slope_and_the_compression_leaves_no_orthogonal_stress() {
+    let (tile, rest) = truth_tile();
+    for direction in [Direction::Weft, Direction::Bias, Direction::Warp] {
+        // Past the slack range of the generated stockinette (its yarns go taut near 30%).
+        let s = 0.45;
+        let zero = zero_orthogonal_stress(&tile, direction, s, 0.0, Some(&rest)).expect("found");
+        assert!(
+            zero.compression_stress_n_m.abs() <= 1e-2 * zero.stretch_stress_n_m.abs().max(1.0),
+            "{direction}: σ_c = {} at σ_s = {}",
+            zero.compression_stress_n_m,
+            zero.stretch_stress_n_m
+        );
+        // (6.10): σ_s = dΨ/ds at fixed c, by central differences of warm-started solves.
+        let h = 2e-3;
+        let energy = |ds: f64| {
+            solve_uniaxial(&tile, direction, s + ds, zero.compression, Some(&zero.state))
+                .expect("solves")
+                .energy_j_m2
+        };
+        let fd = (energy(h) - energy(-h)) / (2.0 * h);
+        assert!(
+            (zero.stretch_stress_n_m - fd).abs() < 0.02 * fd.abs(),
+            "{direction}: σ_s {} vs finite differences {fd}",
+            zero.stretch_stress_n_m
+        );
+        assert!(fd > 0.0, "{direction}: stretching costs energy");
+        // And the compression found is the energy minimum across the pull.
+        let across = |dc: f64| {
+            solve_uniaxial(&tile, direction, s, zero.compression + dc, Some(&zero.state))
+                .expect("solves")
+                .energy_j_m2
+        };
+        let here = zero.energy_j_m2;
+        assert!(across(0.03) > here && across(-0.03) > here, "{direction}: not a minimum in c");
+    }
+}
+
+fn truth_problem() -> YarnProblem {
+    let pattern = stockinette();
+    YarnProblem {
+        basis: basis(&pattern),
+        pattern,
+        source: TargetSource::Yarn(TRUTH.to_vec()),
+        directions: vec![(Direction::Weft, 0.5, 0.06), (Direction::Warp, 0.5, 0.06)],
+        rest: RestShapeSettings { max_length_change: 0.2, max_resets: 8 },
+        comfort_force_n: COMFORT_FORCE_N,
+    }
+}
+
+#[test]
+fn the_hidden_model_has_no_residual_and_the_local_steps_move_towards_it() {
+    let problem = truth_problem();
+    let targets = problem.targets(5).expect("the truth simulates");
+    let at_truth = problem.evaluate(&TRUTH, &targets).expect("evaluates");
+    assert!(residuals(&targets, &at_truth.curves).iter().all(|r| r.abs() < 1e-12));
+    // Start with the yarn 4x softer at low stretch and 3x softer in bending.
+    let start = [TRUTH[0] - 0.6, TRUTH[1], TRUTH[2] - 0.5, TRUTH[3], TRUTH[4]];
+    let mut outcomes = Vec::new();
+    for local in [LocalSolver::Cobyla, LocalSolver::LevenbergMarquardt] {
+        let settings = YarnFitSettings {
+            swarm: SwarmSettings::default(),
+            local_targets: 5,
+            local,
+            local_budget: if local == LocalSolver::Cobyla { 40 } else { 4 },
+            ..YarnFitSettings::default()
+        };
+        let fitted = fit_yarn(&problem, "hidden", &settings, Some(&start), &|_| {}).expect("fits");
+        let report = fitted.fit.local.clone().expect("a local step ran");
+        let worst = fitted.fit.errors.iter().map(|e| e.comfort_stress).fold(0.0, f64::max);
+        outcomes.push((local, report, worst));
+    }
+    // The objective is not smooth (every evaluation re-estimates the rest shape), so neither
+    // optimizer reaches zero; both must remove most of the misfit.
+    for (local, report, worst) in &outcomes {
+        assert!(
+            report.cost < 0.35 * report.start_cost,
+            "{local:?}: {report:?} (worst comfort error {worst})"
+        );
+    }
+}
