@@ -102,7 +102,7 @@ pub enum TileError {
     BadStrain(f64),
 }
 
-/// Solve the tile at `(s, c)` along `direction`, warm-started from `start`.
+/// Solve the tile at `(s, c)` along `direction`, warm-started from `start` (cold if that fails).
 pub fn solve_uniaxial(
     tile: &RveModel,
     direction: Direction,
@@ -114,7 +114,12 @@ pub fn solve_uniaxial(
     let [sx, sa, sy] = map.strain;
     let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0).map_err(|_| TileError::BadStrain(compression))?;
     let options = if start.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
-    let (report, state) = solve_at(tile, &strain, start, &options);
+    let (mut report, mut state) = solve_at(tile, &strain, start, &options);
+    if !report.converged && start.is_some() {
+        // A warm start can sit on a saddle of a slack tile: retry from the affine start with the
+        // full regularization schedule.
+        (report, state) = solve_at(tile, &strain, None, &SolveOptions::default());
+    }
     if !report.converged {
         return Err(TileError::NoEquilibrium { direction, stretch, compression });
     }

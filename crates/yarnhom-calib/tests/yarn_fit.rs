@@ -121,6 +121,7 @@ fn the_hidden_model_has_no_residual_and_the_local_steps_move_towards_it() {
     // The objective is not smooth (every evaluation re-estimates the rest shape), so neither
     // optimizer reaches zero; both must remove most of the misfit.
     for (local, report, worst) in &outcomes {
+        eprintln!("{local:?}: {report:?}, worst comfort stress error {worst:.4}");
         assert!(
             report.cost < 0.35 * report.start_cost,
             "{local:?}: {report:?} (worst comfort error {worst})"

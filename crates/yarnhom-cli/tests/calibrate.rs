@@ -11,6 +11,11 @@ fn yarnhom(args: &[&str], cwd: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_yarnhom")).args(args).current_dir(cwd).output().expect("run yarnhom")
 }
 
+/// The membrane behind the synthetic sets.
+fn known_membrane() -> StvkNeoHookean {
+    StvkNeoHookean { k_xx: 80.0, k_xy: 10.0, k_yy: 30.0, k_ss: 12.0, k_n1: 3.0, k_n2: 1.0, stiffening: None }
+}
+
 fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
@@ -18,15 +23,7 @@ fn text(bytes: &[u8]) -> String {
 #[test]
 fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let truth = StvkNeoHookean {
-        k_xx: 80.0,
-        k_xy: 10.0,
-        k_yy: 30.0,
-        k_ss: 12.0,
-        k_n1: 3.0,
-        k_n2: 1.0,
-        stiffening: None,
-    };
+    let truth = known_membrane();
     let plan = SynthPlan {
         directions: vec![Direction::Weft, Direction::Warp],
         max_stretch: vec![0.25, 0.4],
@@ -150,15 +147,7 @@ fn calibrate_yarn_estimates_a_yarn_model_in_shards_and_writes_its_artifacts() {
         spacing_m: 0.01,
         ..SynthPlan::new("synthetic", 0.3)
     };
-    let truth = StvkNeoHookean {
-        k_xx: 80.0,
-        k_xy: 10.0,
-        k_yy: 30.0,
-        k_ss: 12.0,
-        k_n1: 3.0,
-        k_n2: 1.0,
-        stiffening: None,
-    };
+    let truth = known_membrane();
     synthesize(&truth, &plan).expect("simulates").write(&dir.path().join("set")).expect("writes");
     let small =
         ["--generations", "1", "--swarm-targets", "3", "--local-targets", "3", "--yarn-stiffness", "200"];
