@@ -15,8 +15,10 @@
 //!    ([`yarnhom_shell::Stiffening`]: stiffening past an onset strain), `friction-hysteresis`
 //!    (unloading force `(1 - h)` times the loading force at the same stretch, `h` fitted on the
 //!    even unloading targets). The bending causes (`rest-curvature`, `anisotropic-bending`)
-//!    need the pear-loop simulation and `two-phase-contact` the yarn-level fit; both are not
-//!    built yet, so these candidates are reported as not testable, with the reason.
+//!    need a bending fit over the pear-loop simulation (not built yet), and `two-phase-contact`
+//!    a yarn-level fit with and without the inner barrier ([`crate::yarn_fit`] exists, but its
+//!    minutes per fit are not wired into the diagnosis yet); these candidates are reported as
+//!    not testable, with the reason.
 //! 4. Choice: a candidate is accepted when its held-out error is below 75% of the base's and
 //!    below it by more than twice the noise, and its Akaike criterion
 //!    `n ln(RSS/n) + 2k` on the fitted targets is lower by more than 4. The accepted candidate
@@ -500,7 +502,7 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
             }
             (CauseId::TwoPhaseContact, None) => untestable(
                 id,
-                "a yarn-level cause: screening it needs the yarn-level fit of Sec. 6.5, which is not built yet",
+                "a yarn-level cause: screening it needs yarn-level fits (`calibrate yarn`) with and without the inner contact barrier, which the diagnosis does not run yet",
             ),
             (_, None) => untestable(
                 id,
