@@ -6,13 +6,20 @@
 //! Compared with: the thesis' shell fit has no published time; its yarn-level local solver took
 //! 11 min 49 s per fabric on a share of a 256-core server (Sec. 6.6). A whole shell fit is
 //! 140 to 320 of these evaluations (`yarnhom calibrate shell` prints its count and wall time).
+//!
+//! The bending fit's evaluation (Sec. 6.3.2): the thesis' 7 pear loops (clamp distances 0.3 to
+//! 3.4 cm) along one direction, and 7 cantilevers per face, each simulated to equilibrium.
+//! Compared with: no published time; the thesis reports only the fit's error (5.61% average).
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use yarnhom_calib::measure::Direction;
+use yarnhom_calib::bending_fit::BENDING_SPACING_M;
+use yarnhom_calib::cantilever::CantileverTest;
+use yarnhom_calib::measure::{Direction, Face};
+use yarnhom_calib::pear_loop::PearLoopTest;
 use yarnhom_calib::stitch_by_stitch::import_fabric;
 use yarnhom_calib::swatch::SwatchTest;
 use yarnhom_calib::targets::{TargetPlan, targets};
-use yarnhom_shell::StvkNeoHookean;
+use yarnhom_shell::{HingeBending, StvkNeoHookean};
 
 fn bench_objective(c: &mut Criterion) {
     let data = format!("{}/../../shared/data/stitch-by-stitch-acrylic", env!("CARGO_MANIFEST_DIR"));
@@ -48,5 +55,36 @@ fn bench_objective(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_objective);
+fn bench_bending(c: &mut Criterion) {
+    let membrane = StvkNeoHookean {
+        k_xx: 60.0,
+        k_xy: 6.0,
+        k_yy: 25.0,
+        k_ss: 10.0,
+        k_n1: 0.0,
+        k_n2: 0.0,
+        stiffening: None,
+    };
+    let bending = HingeBending::isotropic(1e-6);
+    let distances: Vec<f64> = (0..7).map(|k| 0.003 + 0.031 * k as f64 / 6.0).collect();
+    let overhangs: Vec<(Face, f64)> =
+        Face::ALL.into_iter().flat_map(|f| (0..7).map(move |k| (f, 0.008 + 0.004 * k as f64))).collect();
+    let pear = PearLoopTest::new(Direction::Weft, 0.1, 0.25, BENDING_SPACING_M);
+    let cantilever = CantileverTest {
+        direction: Direction::Weft,
+        areal_density_kg_m2: 0.25,
+        spacing_m: BENDING_SPACING_M,
+    };
+    let mut g = c.benchmark_group("bending fit");
+    g.sample_size(10);
+    g.bench_function("pear loop: 7 clamp distances, 10 cm strip, 1e-6 J", |b| {
+        b.iter(|| std::hint::black_box(pear.run(&membrane, &bending, &distances).expect("equilibrium")))
+    });
+    g.bench_function("cantilever: 7 overhangs x 2 faces, 1e-6 J", |b| {
+        b.iter(|| std::hint::black_box(cantilever.run(&membrane, &bending, &overhangs).expect("equilibrium")))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_objective, bench_bending);
 criterion_main!(benches);

@@ -39,7 +39,7 @@ fn bench_kernels(c: &mut Criterion) {
     let (_, _, hessian) = model.triangle_element_exact(t, &x, true);
     let hessian = hessian.expect("asked for");
     let hinge = mesh.hinges[0].vertices;
-    let hinge_rest = HingeRest::new(&hinge.map(|v| mesh.material[v as usize]), 1e-5);
+    let hinge_rest = HingeRest::new(&hinge.map(|v| mesh.material[v as usize]), 1e-5, 0.0);
     let hinge_x = hinge.map(|v| x[v as usize]);
 
     let mut g = c.benchmark_group("shell kernels");

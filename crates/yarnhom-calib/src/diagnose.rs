@@ -14,28 +14,38 @@
 //!    `area-preservation` (the Neo-Hookean area terms of (6.1)), `biphasic-stretch`
 //!    ([`yarnhom_shell::Stiffening`]: stiffening past an onset strain), `friction-hysteresis`
 //!    (unloading force `(1 - h)` times the loading force at the same stretch, `h` fitted on the
-//!    even unloading targets). The bending causes (`rest-curvature`, `anisotropic-bending`)
-//!    need a bending fit over the pear-loop simulation (not built yet), and `two-phase-contact`
-//!    a yarn-level fit with and without the inner barrier ([`crate::yarn_fit`] exists, but its
-//!    minutes per fit are not wired into the diagnosis yet); these candidates are reported as
+//!    even unloading targets). `two-phase-contact` needs a yarn-level fit with and without the
+//!    inner barrier ([`crate::yarn_fit`] exists, but its minutes per fit are not wired into the
+//!    diagnosis yet); it is reported as not testable, with the reason.
+//!    The bending causes form a second track on the set's bending tests
+//!    ([`crate::bending_fit`], the even readings of each test, direction and face fitted, the
+//!    odd held out): base isotropic flat bending (one `k_θ`), `anisotropic-bending` (`k_θ` per
+//!    direction) and `rest-curvature` (one `k_θ` and a rest curvature per direction, seen only
+//!    by the cantilever tests on both faces); without the tests (or the areal density) they are
 //!    not testable, with the reason.
-//! 4. Choice: a candidate is accepted when its held-out error is below 75% of the base's and
-//!    below it by more than twice the noise, and its Akaike criterion
+//! 4. Choice: a candidate is accepted when its held-out error is below 75% of its track's
+//!    base's and below it by more than twice the track's noise, and its Akaike criterion
 //!    `n ln(RSS/n) + 2k` on the fitted targets is lower by more than 4. The accepted candidate
-//!    with the lowest held-out error is the cause. Without one, the cause is `none` when the
-//!    base's held-out error is within `max(3 x noise, 3%)`, else `unexplained`.
+//!    with the lowest held-out error relative to its base is the cause. Without one, the cause
+//!    is `none` when every track's base held-out error is within `max(3 x noise, 3%)`, else
+//!    `unexplained`.
 //!
 //! Errors are RMS values of the normalized residuals of (6.2) (force over the direction's mean
 //! force, compression over its mean compression), pooled over the fitted or the held-out
 //! targets; the noise is the pooled standard error of the targets (their readings' scatter
-//! about the local line over the square root of their count).
+//! about the local line over the square root of their count). On the bending track the errors
+//! are those of [`crate::bending_fit`] (each reading over its group's mean), and the noise is
+//! the readings' scatter about a cubic in the abscissa fitted to each test group, pooled
+//! over the residual degrees of freedom (an upper bound where a curve is not cubic).
 
 use std::time::Instant;
 
+use nalgebra::{DMatrix, DVector};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_shell::{Stiffening, StvkNeoHookean};
 
+use crate::bending_fit::{BendingFit, BendingFitError, BendingModel, BendingTest, BendingTests, fit_bending};
 use crate::lm::LmSettings;
 use crate::measure::{Direction, MeasurementSet, Phase};
 use crate::shell_fit::{
@@ -184,7 +194,8 @@ pub struct Cause {
 /// The held-out gain of the extension.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct Gain {
-    /// The base's held-out error.
+    /// The held-out error of the chosen extension's base (the bending base for a bending
+    /// cause, else the stretch base).
     pub heldout_error_before: f64,
     /// The chosen model's held-out error (the base's when the cause is `none`/`unexplained`).
     pub heldout_error_after: f64,
@@ -232,14 +243,34 @@ pub struct Diagnosis {
     pub load_fitted: Vec<bool>,
     /// Predictions of the base and of the chosen extension.
     pub predictions: Vec<Prediction>,
+    /// The bending track, when the set has bending tests.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending: Option<BendingTrack>,
     /// Wall time (s).
     pub wall_time_s: f64,
+}
+
+/// The bending track of a diagnosis.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct BendingTrack {
+    /// Base: isotropic flat bending.
+    pub base: ModelResult,
+    /// Noise level of the readings (RMS normalized, difference-based).
+    pub noise: f64,
+    /// The tests, in file order (pear loops, then cantilevers).
+    pub tests: Vec<BendingTest>,
+    /// The measured readings.
+    pub measured: Vec<f64>,
+    /// Whether each reading was fitted (else held out).
+    pub fitted: Vec<bool>,
+    /// Simulated readings of the base and of the chosen bending extension (if one is chosen).
+    pub predictions: Vec<(String, Vec<f64>)>,
 }
 
 /// Format tag of [`Diagnosis`] files.
 pub const DIAGNOSIS_FORMAT: &str = "yarnhom.diagnosis";
 /// Layout version of [`Diagnosis`] files.
-pub const DIAGNOSIS_VERSION: u32 = 1;
+pub const DIAGNOSIS_VERSION: u32 = 2;
 
 /// The JSON Schema of `report.json`.
 pub fn diagnosis_schema() -> schemars::Schema {
@@ -425,6 +456,122 @@ fn noise_level(phases: &Phases) -> f64 {
     rms(&errors)
 }
 
+/// A bending model's result, from its fit.
+fn bending_result(id: &str, fit: &BendingFit, tests: &BendingTests, note: Option<String>) -> ModelResult {
+    let b = &fit.bending;
+    let mut params = match fit.model {
+        BendingModel::Anisotropic => vec![
+            ("k_weft".to_string(), b.k_weft),
+            ("k_bias".to_string(), b.k_bias),
+            ("k_warp".to_string(), b.k_warp),
+        ],
+        _ => vec![("k".to_string(), b.k_weft)],
+    };
+    if fit.model == BendingModel::RestCurvature {
+        params.extend([
+            ("rest_curvature_weft".to_string(), b.rest_curvature_weft),
+            ("rest_curvature_bias".to_string(), b.rest_curvature_bias),
+            ("rest_curvature_warp".to_string(), b.rest_curvature_warp),
+        ]);
+    }
+    let fitted = tests.residuals(&fit.simulated, true);
+    ModelResult {
+        id: id.into(),
+        testable: true,
+        note,
+        params,
+        parameter_count: fit.parameter_count,
+        error: Some(fit.error),
+        heldout_error: fit.heldout_error,
+        criterion: Some(criterion(&fitted, fit.parameter_count)),
+    }
+}
+
+/// The noise of the bending readings (RMS normalized): the scatter about a cubic in the
+/// abscissa, fitted to each test group (degree lowered to keep a residual degree of freedom),
+/// pooled over the groups' degrees of freedom.
+fn bending_noise(tests: &BendingTests) -> f64 {
+    let normalized = tests.normalized_readings();
+    let abscissa = tests.abscissas();
+    let (mut squares, mut freedom) = (0.0, 0);
+    for group in tests.groups() {
+        let n = group.len();
+        if n < 3 {
+            continue;
+        }
+        let degree = 3.min(n - 2);
+        let (lo, hi) = group
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &i| (a.min(abscissa[i]), b.max(abscissa[i])));
+        let t = |i: usize| 2.0 * (abscissa[i] - lo) / (hi - lo).max(1e-300) - 1.0;
+        let design = DMatrix::from_fn(n, degree + 1, |r, c| t(group[r]).powi(c as i32));
+        let y = DVector::from_iterator(n, group.iter().map(|&i| normalized[i]));
+        let Ok(coefficients) = design.clone().svd(true, true).solve(&y, 1e-12) else { continue };
+        squares += (design * coefficients - y).norm_squared();
+        freedom += n - degree - 1;
+    }
+    if freedom == 0 { 0.0 } else { (squares / freedom as f64).sqrt() }
+}
+
+/// The bending track: the base and the two bending candidates, or why it cannot run.
+struct BendingOutcome {
+    track: Option<BendingTrack>,
+    candidates: Vec<(CauseId, ModelResult, Option<BendingFit>)>,
+}
+
+fn bending_track(
+    set: &MeasurementSet,
+    membrane: &StvkNeoHookean,
+    settings: &DiagnoseSettings,
+) -> BendingOutcome {
+    let ids = [CauseId::AnisotropicBending, CauseId::RestCurvature];
+    let untestable_all = |note: &str| BendingOutcome {
+        track: None,
+        candidates: ids.iter().map(|&id| (id, untestable(id, note), None)).collect(),
+    };
+    let tests = match BendingTests::of_set(set, |k| k.is_multiple_of(2)) {
+        Ok(t) => t,
+        Err(BendingFitError::NoTests) => return untestable_all("no bending tests in the set"),
+        Err(e) => return untestable_all(&e.to_string()),
+    };
+    let Ok(base) = fit_bending(&tests, membrane, BendingModel::Isotropic, None, &settings.lm) else {
+        return untestable_all("no isotropic bending stiffness gives the bending tests an equilibrium");
+    };
+    let has_cantilever = tests.tests.iter().any(|t| matches!(t, BendingTest::Cantilever { .. }));
+    let candidates = ids
+        .iter()
+        .map(|&id| {
+            let model = match id {
+                CauseId::AnisotropicBending => BendingModel::Anisotropic,
+                _ => BendingModel::RestCurvature,
+            };
+            if model == BendingModel::RestCurvature && !has_cantilever {
+                let note = "rest curvature needs cantilever tests on both faces: a clamped pear loop cannot show it \
+                            (the clamps fix the end tangents, so a uniform rest curvature does no work)";
+                return (id, untestable(id, note), None);
+            }
+            match fit_bending(&tests, membrane, model, Some(&base.bending), &settings.lm) {
+                Ok(fit) => (id, bending_result(id.as_str(), &fit, &tests, None), Some(fit)),
+                Err(e) => (id, untestable(id, &e.to_string()), None),
+            }
+        })
+        .collect();
+    let track = BendingTrack {
+        base: bending_result(
+            "bending-base",
+            &base,
+            &tests,
+            Some("isotropic flat hinge bending (6.4)".into()),
+        ),
+        noise: bending_noise(&tests),
+        tests: tests.tests.clone(),
+        measured: tests.measured.clone(),
+        fitted: tests.fitted.clone(),
+        predictions: vec![("bending-base".into(), base.simulated.clone())],
+    };
+    BendingOutcome { track: Some(track), candidates }
+}
+
 /// Diagnose `set`.
 pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Diagnosis, ShellFitError> {
     let started = Instant::now();
@@ -453,9 +600,17 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         fit_model(&phases, base_terms, starting_material(&phases.load.data, base_terms), &settings.lm)?;
     let base = base_fit.result("base", &phases, Some("anisotropic StVK, unloading as loading".into()));
 
+    let mut bending = bending_track(set, &base_fit.material, settings);
     let mut fits: Vec<(CauseId, Fitted)> = Vec::new();
+    let mut bending_fits: Vec<(CauseId, BendingFit)> = Vec::new();
     let mut candidates = Vec::new();
     for id in CauseId::CANDIDATES {
+        if let Some(k) = bending.candidates.iter().position(|(c, _, _)| *c == id) {
+            let (_, result, fit) = bending.candidates.swap_remove(k);
+            bending_fits.extend(fit.map(|f| (id, f)));
+            candidates.push(result);
+            continue;
+        }
         let extended = match id {
             CauseId::AreaPreservation | CauseId::BiphasicStretch => {
                 let terms = Terms {
@@ -497,21 +652,11 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
             (CauseId::FrictionHysteresis, None) => {
                 untestable(id, unload_note.as_deref().unwrap_or("no unloading data"))
             }
-            (CauseId::AreaPreservation | CauseId::BiphasicStretch, None) => {
-                untestable(id, "the extended swatch has no equilibrium from the base fit")
-            }
             (CauseId::TwoPhaseContact, None) => untestable(
                 id,
                 "a yarn-level cause: screening it needs yarn-level fits (`calibrate yarn`) with and without the inner contact barrier, which the diagnosis does not run yet",
             ),
-            (_, None) => untestable(
-                id,
-                if set.bending.is_empty() {
-                    "no bending tests in the set"
-                } else {
-                    "the pear-loop bending simulation of Sec. 6.3.2 is not built yet"
-                },
-            ),
+            (_, None) => untestable(id, "the extended swatch has no equilibrium from the base fit"),
         };
         candidates.push(result);
     }
@@ -520,50 +665,69 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
     let score = |m: &ModelResult| {
         (m.error.unwrap_or(f64::NAN), m.heldout_error.unwrap_or(f64::NAN), m.criterion.unwrap_or(f64::NAN))
     };
-    let (base_error, base_heldout, base_criterion) = score(&base);
+    let is_bending =
+        |id: &str| id == CauseId::AnisotropicBending.as_str() || id == CauseId::RestCurvature.as_str();
+    // A candidate's track: its base and noise.
+    let track_of = |c: &ModelResult| match (&bending.track, is_bending(&c.id)) {
+        (Some(t), true) => (&t.base, t.noise),
+        _ => (&base, noise),
+    };
+    let (base_error, base_heldout, _) = score(&base);
     let passing: Vec<&ModelResult> = candidates
         .iter()
         .filter(|c| c.testable)
         .filter(|c| {
+            let (track_base, track_noise) = track_of(c);
             let (_, heldout, criterion) = score(c);
+            let (_, base_heldout, base_criterion) = score(track_base);
             heldout < 0.75 * base_heldout
-                && heldout < base_heldout - 2.0 * noise
+                && heldout < base_heldout - 2.0 * track_noise
                 && criterion < base_criterion - 4.0
         })
         .collect();
-    let accepted = passing.iter().min_by(|a, b| score(a).1.total_cmp(&score(b).1)).copied();
+    let relative = |c: &ModelResult| score(c).1 / score(track_of(c).0).1;
+    let accepted = passing.iter().min_by(|a, b| relative(a).total_cmp(&relative(b))).copied();
     let mut evidence = vec![format!(
         "base (anisotropic StVK): fitted error {base_error:.4}, held-out error {base_heldout:.4}, noise {noise:.4}"
     )];
-    for c in candidates.iter().filter(|c| c.testable) {
-        let (_, heldout, criterion) = score(c);
+    if let Some(t) = &bending.track {
+        let (e, h, _) = score(&t.base);
         evidence.push(format!(
-            "{}: held-out error {heldout:.4} ({:+.1}% vs base), criterion {:+.1} vs base",
-            c.id,
-            100.0 * (heldout / base_heldout - 1.0),
-            criterion - base_criterion
+            "bending base (isotropic flat hinges, {} bending readings): fitted error {e:.4}, held-out error {h:.4}, noise {:.4}",
+            t.tests.len(),
+            t.noise
         ));
     }
+    for c in candidates.iter().filter(|c| c.testable) {
+        let (_, heldout, criterion) = score(c);
+        let (track_base, _) = track_of(c);
+        evidence.push(format!(
+            "{}: held-out error {heldout:.4} ({:+.1}% vs {}), criterion {:+.1} vs {}",
+            c.id,
+            100.0 * (relative(c) - 1.0),
+            track_base.id,
+            criterion - score(track_base).2,
+            track_base.id
+        ));
+    }
+    let bases_within_noise = std::iter::once((score(&base).1, noise))
+        .chain(bending.track.iter().map(|t| (score(&t.base).1, t.noise)))
+        .all(|(heldout, noise)| heldout <= (3.0 * noise).max(0.03));
     let (id, extended) = match accepted {
         Some(c) => {
             let id = CauseId::CANDIDATES.into_iter().find(|i| i.as_str() == c.id).expect("a catalog id");
             (id, Some(c.clone()))
         }
-        None if base_heldout <= (3.0 * noise).max(0.03) => (CauseId::None, None),
+        None if bases_within_noise => (CauseId::None, None),
         None => (CauseId::Unexplained, None),
     };
     evidence.push(match id {
-        CauseId::None => format!(
-            "no candidate passes the tests (held-out error below 75% of the base's, by more than 2 x noise, criterion lower by 4), and the base's held-out error {:.4} is within max(3 x noise, 0.03) = {:.4}",
-            base_heldout,
-            (3.0 * noise).max(0.03)
+        CauseId::None => "no candidate passes the tests (held-out error below 75% of its base's, by more than 2 x noise, criterion lower by 4), and every base's held-out error is within max(3 x noise, 0.03) of its track".to_string(),
+        CauseId::Unexplained => "no candidate passes the tests, and a base's held-out error exceeds max(3 x noise, 0.03) of its track".to_string(),
+        _ => format!(
+            "chosen: {} (lowest held-out error relative to its base among the candidates that pass the tests)",
+            id.as_str()
         ),
-        CauseId::Unexplained => format!(
-            "no candidate passes the tests, and the base's held-out error {:.4} exceeds max(3 x noise, 0.03) = {:.4}",
-            base_heldout,
-            (3.0 * noise).max(0.03)
-        ),
-        _ => format!("chosen: {} (lowest held-out error among the candidates that pass the tests)", id.as_str()),
     });
     let also: Vec<&str> = passing.iter().map(|c| c.id.as_str()).filter(|c| *c != id.as_str()).collect();
     if !also.is_empty() {
@@ -571,6 +735,14 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
             "also passing: {} (a combination may explain more; only single causes are screened)",
             also.join(", ")
         ));
+    }
+    let heldout_before = match &extended {
+        Some(c) => score(track_of(c).0).1,
+        None => base_heldout,
+    };
+    let mut bending_track = bending.track;
+    if let (Some(t), Some((cid, f))) = (bending_track.as_mut(), bending_fits.iter().find(|(c, _)| *c == id)) {
+        t.predictions.push((cid.as_str().into(), f.simulated.clone()));
     }
     let mut predictions = vec![base_fit.prediction("base")];
     if let Some((cid, f)) = fits.iter().find(|(c, _)| *c == id) {
@@ -584,7 +756,7 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         settings: *settings,
         cause: Cause { id, explanation: id.explanation().into(), evidence },
         gain: Gain {
-            heldout_error_before: base_heldout,
+            heldout_error_before: heldout_before,
             heldout_error_after: extended.as_ref().map_or(base_heldout, |e| score(e).1),
         },
         base,
@@ -595,6 +767,7 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         unload_targets: unload_targets.unwrap_or_default(),
         load_fitted,
         predictions,
+        bending: bending_track,
         wall_time_s: started.elapsed().as_secs_f64(),
     })
 }

@@ -1,10 +1,13 @@
 //! Calibration inputs of yarnhom: measurement sets of real fabric swatches.
 //!
 //! A measurement set is a directory holding `fabric.toml` (what was measured), `stretch.csv`
-//! (uniaxial stretch tests) and optionally `bending.csv` (pear-loop bending tests); see
+//! (uniaxial stretch tests) and optionally `bending.csv` (pear-loop bending tests) and
+//! `cantilever.csv` (cantilever bending tests, both faces); see
 //! [`measure`] and `schemas/measurement-set.md`. [`stitch_by_stitch`] (feature `hdf5`) turns the
 //! published stitch-by-stitch HDF5 files into measurement sets.
 
+pub mod bending_fit;
+pub mod cantilever;
 pub mod diagnose;
 pub mod lm;
 pub mod measure;
@@ -12,6 +15,7 @@ pub mod pear_loop;
 pub mod shell_fit;
 #[cfg(feature = "hdf5")]
 pub mod stitch_by_stitch;
+pub mod strip;
 pub mod swarm;
 pub mod swatch;
 pub mod synth;
@@ -25,6 +29,6 @@ pub mod yarn_params;
 pub mod yarn_tile;
 
 pub use measure::{
-    BendingPoint, Direction, Fabric, MeasureError, MeasurementSet, Phase, Specimen, StretchPoint, Swatch,
-    SwatchOverride, Yarn,
+    BendingPoint, CantileverPoint, Direction, Fabric, Face, MeasureError, MeasurementSet, Phase, Specimen,
+    StretchPoint, Swatch, SwatchOverride, Yarn,
 };

@@ -4,6 +4,7 @@
 //! DIR/fabric.toml    name, pattern, [swatch], [[yarn]]
 //! DIR/stretch.csv    direction,stretch,force_n,compression,phase,repeat
 //! DIR/bending.csv    direction,clamp_distance_m,aspect_ratio      (optional)
+//! DIR/cantilever.csv direction,face,overhang_m,tip_drop_m         (optional)
 //! ```
 //!
 //! The full format, units, defaults and validation rules are in `schemas/measurement-set.md`.
@@ -24,6 +25,8 @@ pub const FABRIC_FILE: &str = "fabric.toml";
 pub const STRETCH_FILE: &str = "stretch.csv";
 /// File name of the (optional) pear-loop bending tests in a measurement set.
 pub const BENDING_FILE: &str = "bending.csv";
+/// File name of the (optional) cantilever bending tests in a measurement set.
+pub const CANTILEVER_FILE: &str = "cantilever.csv";
 
 /// Absolute part of the negative-force noise floor, in newtons: a force below
 /// `-max(NEGATIVE_FORCE_FLOOR_N, NEGATIVE_FORCE_FRACTION * largest |force|)` at positive stretch
@@ -40,6 +43,7 @@ pub const DEFAULT_SWATCH_WIDTH_M: f64 = 0.06;
 const STRETCH_COLUMNS: [&str; 6] = ["direction", "stretch", "force_n", "compression", "phase", "repeat"];
 const STRETCH_REQUIRED: [&str; 3] = ["direction", "stretch", "force_n"];
 const BENDING_COLUMNS: [&str; 3] = ["direction", "clamp_distance_m", "aspect_ratio"];
+const CANTILEVER_COLUMNS: [&str; 4] = ["direction", "face", "overhang_m", "tip_drop_m"];
 
 /// Why a measurement set could not be read or written.
 #[derive(Debug, thiserror::Error)]
@@ -159,6 +163,40 @@ impl Phase {
 }
 
 impl fmt::Display for Phase {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Which face of the fabric is up in a cantilever test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
+#[serde(rename_all = "snake_case")]
+pub enum Face {
+    /// The reference face up (the technical face of a knit; the material frame's normal): `up`.
+    Up,
+    /// Turned over: `down`.
+    Down,
+}
+
+impl Face {
+    /// Both faces, in file order.
+    pub const ALL: [Face; 2] = [Face::Up, Face::Down];
+
+    /// The name used in the CSV files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Face::Up => "up",
+            Face::Down => "down",
+        }
+    }
+
+    /// The face named `name` (`up` or `down`), if any.
+    pub fn parse(name: &str) -> Option<Face> {
+        Face::ALL.into_iter().find(|f| f.as_str() == name)
+    }
+}
+
+impl fmt::Display for Face {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.as_str())
     }
@@ -351,6 +389,20 @@ pub struct BendingPoint {
     pub aspect_ratio: f64,
 }
 
+/// One row of `cantilever.csv`: a cantilever bending test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CantileverPoint {
+    /// Direction of the strip's long axis.
+    pub direction: Direction,
+    /// Which face was up.
+    pub face: Face,
+    /// Free length beyond the clamp, in metres (> 0).
+    pub overhang_m: f64,
+    /// Drop of the free end below the clamp, in metres (negative when it curls up; at most the
+    /// overhang in size).
+    pub tip_drop_m: f64,
+}
+
 /// A measurement set: the fabric, its stretch tests and its bending tests.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeasurementSet {
@@ -360,6 +412,8 @@ pub struct MeasurementSet {
     pub stretch: Vec<StretchPoint>,
     /// `bending.csv`, in file order (empty when the file is absent).
     pub bending: Vec<BendingPoint>,
+    /// `cantilever.csv`, in file order (empty when the file is absent).
+    pub cantilever: Vec<CantileverPoint>,
 }
 
 impl MeasurementSet {
@@ -369,11 +423,15 @@ impl MeasurementSet {
         let stretch = read_stretch(&dir.join(STRETCH_FILE))?;
         let bending_path = dir.join(BENDING_FILE);
         let bending = if bending_path.exists() { read_bending(&bending_path)? } else { Vec::new() };
-        Ok(MeasurementSet { fabric, stretch, bending })
+        let cantilever_path = dir.join(CANTILEVER_FILE);
+        let cantilever =
+            if cantilever_path.exists() { read_cantilever(&cantilever_path)? } else { Vec::new() };
+        Ok(MeasurementSet { fabric, stretch, bending, cantilever })
     }
 
     /// Write the set into directory `dir` (created if missing; files of the same names are
-    /// replaced, and a stale `bending.csv` is removed when the set has no bending points).
+    /// replaced, and a stale `bending.csv` or `cantilever.csv` is removed when the set has no
+    /// such points).
     pub fn write(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|error| MeasureError::Io { path: dir.to_path_buf(), error })?;
         let fabric_path = dir.join(FABRIC_FILE);
@@ -381,14 +439,14 @@ impl MeasurementSet {
             .map_err(|e| MeasureError::Toml { path: fabric_path.clone(), message: e.to_string() })?;
         write_file(&fabric_path, &fabric)?;
         write_file(&dir.join(STRETCH_FILE), &stretch_csv(&self.stretch))?;
-        let bending_path = dir.join(BENDING_FILE);
-        if !self.bending.is_empty() {
-            write_file(&bending_path, &bending_csv(&self.bending))?;
-        } else if bending_path.exists() {
-            std::fs::remove_file(&bending_path)
-                .map_err(|error| MeasureError::Io { path: bending_path, error })?;
-        }
-        Ok(())
+        write_optional_file(
+            &dir.join(BENDING_FILE),
+            (!self.bending.is_empty()).then(|| bending_csv(&self.bending)),
+        )?;
+        write_optional_file(
+            &dir.join(CANTILEVER_FILE),
+            (!self.cantilever.is_empty()).then(|| cantilever_csv(&self.cantilever)),
+        )
     }
 
     /// A human summary: the fabric, then points per direction and phase with their stretch and
@@ -414,6 +472,15 @@ impl MeasurementSet {
             let n = self.bending.iter().filter(|p| p.direction == direction).count();
             if n > 0 {
                 lines.push(format!("  {direction}: {n}"));
+            }
+        }
+        lines.push(format!("cantilever points: {}", self.cantilever.len()));
+        for direction in Direction::ALL {
+            for face in Face::ALL {
+                let n = self.cantilever.iter().filter(|p| p.direction == direction && p.face == face).count();
+                if n > 0 {
+                    lines.push(format!("  {direction} face {face}: {n}"));
+                }
             }
         }
         lines.join("\n")
@@ -447,6 +514,17 @@ fn write_file(path: &Path, text: &str) -> Result<()> {
     std::fs::write(path, text).map_err(|error| MeasureError::Io { path: path.to_path_buf(), error })
 }
 
+/// Write `text` to `path`, or remove a stale `path` when there is nothing to write.
+fn write_optional_file(path: &Path, text: Option<String>) -> Result<()> {
+    match text {
+        Some(text) => write_file(path, &text),
+        None if path.exists() => {
+            std::fs::remove_file(path).map_err(|error| MeasureError::Io { path: path.to_path_buf(), error })
+        }
+        None => Ok(()),
+    }
+}
+
 fn read_text(path: &Path) -> Result<String> {
     std::fs::read_to_string(path).map_err(|error| MeasureError::Io { path: path.to_path_buf(), error })
 }
@@ -475,6 +553,16 @@ fn bending_csv(points: &[BendingPoint]) -> String {
     text.push('\n');
     for p in points {
         text.push_str(&format!("{},{},{}\n", p.direction, p.clamp_distance_m, p.aspect_ratio));
+    }
+    text
+}
+
+/// The text of `cantilever.csv` for `points`.
+fn cantilever_csv(points: &[CantileverPoint]) -> String {
+    let mut text = CANTILEVER_COLUMNS.join(",");
+    text.push('\n');
+    for p in points {
+        text.push_str(&format!("{},{},{},{}\n", p.direction, p.face, p.overhang_m, p.tip_drop_m));
     }
     text
 }
@@ -678,6 +766,13 @@ impl Table {
         }
     }
 
+    fn face(&self, row: &Row) -> Result<Face> {
+        let text = self.cell(row, "face").unwrap_or("");
+        Face::parse(text).ok_or_else(|| {
+            self.error(row.line, "face", &format!("unknown face `{text}` (expected up or down)"))
+        })
+    }
+
     fn repeat(&self, row: &Row) -> Result<Option<u32>> {
         match self.cell(row, "repeat") {
             None | Some("") => Ok(None),
@@ -754,6 +849,27 @@ fn bending_point(table: &Table, row: &Row) -> Result<BendingPoint> {
     Ok(BendingPoint { direction, clamp_distance_m, aspect_ratio })
 }
 
+/// Read and validate `cantilever.csv`.
+pub fn read_cantilever(path: &Path) -> Result<Vec<CantileverPoint>> {
+    let table = Table::read(path, &CANTILEVER_COLUMNS, &CANTILEVER_COLUMNS)?;
+    table.rows.iter().map(|row| cantilever_point(&table, row)).collect()
+}
+
+fn cantilever_point(table: &Table, row: &Row) -> Result<CantileverPoint> {
+    let direction = table.direction(row)?;
+    let face = table.face(row)?;
+    let overhang_m = table.number(row, "overhang_m")?;
+    if overhang_m <= 0.0 {
+        return Err(table.error(row.line, "overhang_m", "must be > 0"));
+    }
+    let tip_drop_m = table.number(row, "tip_drop_m")?;
+    if tip_drop_m.abs() > overhang_m {
+        let message = format!("a drop of {tip_drop_m} m is longer than the overhang {overhang_m} m");
+        return Err(table.error(row.line, "tip_drop_m", &message));
+    }
+    Ok(CantileverPoint { direction, face, overhang_m, tip_drop_m })
+}
+
 /// Within each direction, the clamp distance must be strictly monotone in row order (increasing
 /// or decreasing, as set by the direction's first two rows).
 fn check_monotone_clamp_distance(table: &Table, points: &[BendingPoint]) -> Result<()> {
@@ -828,7 +944,68 @@ mod tests {
                 BendingPoint { direction: Direction::Warp, clamp_distance_m: 0.05, aspect_ratio: 1.2 },
                 BendingPoint { direction: Direction::Warp, clamp_distance_m: 0.04, aspect_ratio: 1.4 },
             ],
+            cantilever: vec![
+                CantileverPoint {
+                    direction: Direction::Weft,
+                    face: Face::Up,
+                    overhang_m: 0.05,
+                    tip_drop_m: 0.01,
+                },
+                CantileverPoint {
+                    direction: Direction::Weft,
+                    face: Face::Down,
+                    overhang_m: 0.05,
+                    tip_drop_m: -1.0 / 3.0 * 1e-3,
+                },
+            ],
         }
+    }
+
+    #[test]
+    fn cantilever_errors_name_line_and_column() {
+        let cases = [
+            (
+                "direction,face,overhang_m,tip_drop_m
+weft,sideways,0.05,0.01
+",
+                ":2: column `face`: unknown face",
+            ),
+            (
+                "direction,face,overhang_m,tip_drop_m
+weft,up,0,0
+",
+                ":2: column `overhang_m`: must be > 0",
+            ),
+            (
+                "direction,face,overhang_m,tip_drop_m
+weft,up,0.05,0.06
+",
+                ":2: column `tip_drop_m`: a drop of 0.06",
+            ),
+            (
+                "direction,face,overhang_m
+weft,up,0.05
+",
+                ":1: column `tip_drop_m`: missing required column",
+            ),
+        ];
+        for (csv, expected) in cases {
+            let dir = tempfile::tempdir().expect("tempdir");
+            example().write(dir.path()).expect("write");
+            std::fs::write(dir.path().join(CANTILEVER_FILE), csv).expect("write");
+            let error = MeasurementSet::read(dir.path()).expect_err("must fail").to_string();
+            assert!(error.contains("cantilever.csv") && error.contains(expected), "{error} lacks {expected}");
+        }
+    }
+
+    #[test]
+    fn writing_a_set_without_bending_tests_removes_stale_files() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        example().write(dir.path()).expect("write");
+        let stretch_only = MeasurementSet { bending: vec![], cantilever: vec![], ..example() };
+        stretch_only.write(dir.path()).expect("write");
+        assert!(!dir.path().join(BENDING_FILE).exists() && !dir.path().join(CANTILEVER_FILE).exists());
+        assert_eq!(MeasurementSet::read(dir.path()).expect("read"), stretch_only);
     }
 
     /// Write `stretch` as stretch.csv (and a valid fabric.toml) and return the read error.

@@ -8,26 +8,24 @@
 //! its weight against its bending stiffness (the bending length `(B / w)^⅓`) sets how far it
 //! sags, which is what the test measures.
 //!
-//! The strip lies along `a` in its frame, its material coordinates rotated by the direction's
-//! angle (as in [`crate::swatch`]). Each clamp holds two columns of vertices one edge apart,
-//! fixing the end's position and tangent; the free length between the inner columns is the
-//! swatch length. The loop starts from the shape `θ(s) = α sin(2π s / L)` (tangent angle along
-//! the arc), whose ends are `L J₀(α)` apart with horizontal tangents, `α` chosen so that this is
-//! `d`, hanging downwards; then the static equilibrium with gravity is solved
-//! ([`yarnhom_shell::statics`]) with the (6.1) membrane and the (6.4) hinges.
+//! The strip ([`crate::strip`]) is clamped at both ends. The loop starts from the shape
+//! `θ(s) = α sin(2π s / L)` (tangent angle along the arc), whose ends are `L J₀(α)` apart with
+//! horizontal tangents, `α` chosen so that this is `d`, hanging downwards; then the static
+//! equilibrium with gravity is solved ([`yarnhom_shell::statics`]) with the (6.1) membrane and
+//! the (6.4) hinges.
+//!
+//! A uniform rest curvature `κ̄` does not change the loop: the bending energy
+//! `k ∫ (κ - κ̄)² ds = k ∫ κ² ds - 2 k κ̄ (θ(L) - θ(0)) + const`, and the clamps fix the
+//! tangents at both ends. (A curling fabric shows in the cantilever test, [`crate::cantilever`].)
 
-use nalgebra::{Rotation2, Vector2, Vector3};
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 use yarnhom_rve::linear::SpdSolver;
-use yarnhom_shell::elastic::ElasticModel;
-use yarnhom_shell::statics::{StaticError, StaticSettings, solve_static};
-use yarnhom_shell::{HingeBending, ShellMaterial, ShellMesh, StvkNeoHookean};
+use yarnhom_shell::statics::StaticError;
+use yarnhom_shell::{HingeBending, StvkNeoHookean};
 
 use crate::measure::Direction;
-use crate::uniform::direction_angle;
-
-/// Standard gravity (m/s²).
-const GRAVITY: f64 = 9.81;
+use crate::strip::{Clamps, Strip};
 
 /// A simulated pear-loop reading.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
@@ -40,6 +38,8 @@ pub struct PearLoopReading {
     pub width_m: f64,
     /// `height / width`.
     pub aspect_ratio: f64,
+    /// Largest curvature along the strip's centre line (1/m).
+    pub max_curvature_per_m: f64,
 }
 
 /// Why a simulated pear loop failed.
@@ -73,47 +73,14 @@ pub enum PearLoopError {
 /// One direction's pear-loop strip, meshed.
 #[derive(Debug, Clone)]
 pub struct PearLoopTest {
-    /// Direction of the strip's long axis.
-    pub direction: Direction,
-    /// Free length between the clamps (m).
-    pub length_m: f64,
-    mesh: ShellMesh,
-    /// Arc length of each vertex from the first clamp's inner column (negative inside it), and
-    /// its position across the strip.
-    arc: Vec<(f64, f64)>,
-    fixed: Vec<bool>,
-    areal_density_kg_m2: f64,
+    strip: Strip,
 }
 
 impl PearLoopTest {
-    /// A strip of free length `length_m` and width `width_m` cut along `direction`, of
-    /// `areal_density_kg_m2`, meshed with edges of about `spacing_m`.
-    pub fn new(
-        direction: Direction,
-        length_m: f64,
-        width_m: f64,
-        areal_density_kg_m2: f64,
-        spacing_m: f64,
-    ) -> Self {
-        let columns = ((length_m / spacing_m).round() as usize).max(8);
-        let h = length_m / columns as f64;
-        let rows = ((width_m / spacing_m).round() as usize + 1).max(2);
-        // One extra column at each end: the clamps hold two columns.
-        let total = length_m + 2.0 * h;
-        let frame =
-            ShellMesh::rectangle(total, width_m, columns + 3, rows).expect("a rectangle is a valid mesh");
-        let rotation = Rotation2::new(direction_angle(direction));
-        let material: Vec<Vector2<f64>> = frame.material.iter().map(|m| rotation * m).collect();
-        let mesh =
-            ShellMesh::new(material, frame.triangles.clone()).expect("a rotation keeps the mesh valid");
-        let arc: Vec<(f64, f64)> = frame.material.iter().map(|m| (m.x + 0.5 * length_m, m.y)).collect();
-        let mut fixed = vec![false; 3 * arc.len()];
-        for (v, (s, _)) in arc.iter().enumerate() {
-            if *s < 1e-9 * length_m || *s > length_m * (1.0 - 1e-9) {
-                fixed[3 * v..3 * v + 3].fill(true);
-            }
-        }
-        Self { direction, length_m, mesh, arc, fixed, areal_density_kg_m2 }
+    /// A strip of free length `length_m` cut along `direction`, of `areal_density_kg_m2`,
+    /// meshed with edges of about `spacing_m`.
+    pub fn new(direction: Direction, length_m: f64, areal_density_kg_m2: f64, spacing_m: f64) -> Self {
+        Self { strip: Strip::new(direction, length_m, areal_density_kg_m2, spacing_m, Clamps::Both) }
     }
 
     /// Simulate the loop at each clamp distance with the membrane and the hinge bending.
@@ -123,26 +90,17 @@ impl PearLoopTest {
         bending: &HingeBending,
         clamp_distances_m: &[f64],
     ) -> Result<Vec<PearLoopReading>, PearLoopError> {
-        let model = ElasticModel::new(
-            self.mesh.clone(),
-            ShellMaterial::stvk(self.areal_density_kg_m2, *membrane, *bending),
-        );
-        let weights: Vec<Vector3<f64>> = self
-            .mesh
-            .vertex_areas()
-            .iter()
-            .map(|a| Vector3::new(0.0, 0.0, -GRAVITY * a * self.areal_density_kg_m2))
-            .collect();
+        let model = self.strip.model(membrane, bending);
+        let weights = self.strip.weights();
         let mut solver = SpdSolver::default();
         clamp_distances_m
             .iter()
             .map(|&d| {
                 let mut x = self.initial_loop(d)?;
-                let settings = StaticSettings { max_iterations: 300, tolerance_m: 1e-9 };
-                let stats = solve_static(&model, &mut x, &self.fixed, &weights, settings, &mut solver)?;
+                let stats = self.strip.settle(&model, &mut x, &weights, &mut solver)?;
                 if !stats.converged {
                     return Err(PearLoopError::NotConverged {
-                        direction: self.direction,
+                        direction: self.strip.direction,
                         clamp_distance_m: d,
                         iterations: stats.iterations,
                     });
@@ -155,7 +113,7 @@ impl PearLoopTest {
     /// The starting loop for clamp distance `d`: `θ(s) = α sin(2π s / L)` with `L J₀(α) = d`,
     /// hanging downwards; the clamped columns straight along `x`.
     fn initial_loop(&self, d: f64) -> Result<Vec<Vector3<f64>>, PearLoopError> {
-        let length = self.length_m;
+        let length = self.strip.length_m;
         if !(d > 0.0 && d < length) {
             return Err(PearLoopError::NoLoop { clamp_distance_m: d, length_m: length });
         }
@@ -178,6 +136,7 @@ impl PearLoopTest {
         };
         let x0 = -0.5 * d;
         Ok(self
+            .strip
             .arc
             .iter()
             .map(|&(s, across)| {
@@ -194,12 +153,17 @@ impl PearLoopTest {
     }
 
     fn read(&self, x: &[Vector3<f64>], d: f64) -> PearLoopReading {
-        let free =
-            || x.iter().zip(&self.arc).filter(|(_, (s, _))| *s > 0.0 && *s < self.length_m).map(|(p, _)| p);
+        let free = || self.strip.free(x);
         let height_m = -free().map(|p| p.z).fold(f64::INFINITY, f64::min);
         let (lo, hi) = free().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p.x), b.max(p.x)));
         let width_m = hi - lo;
-        PearLoopReading { clamp_distance_m: d, height_m, width_m, aspect_ratio: height_m / width_m }
+        PearLoopReading {
+            clamp_distance_m: d,
+            height_m,
+            width_m,
+            aspect_ratio: height_m / width_m,
+            max_curvature_per_m: self.strip.max_curvature(x),
+        }
     }
 }
 
@@ -230,18 +194,18 @@ mod tests {
     use crate::test_support::knit_membrane;
 
     fn bending(k: f64) -> HingeBending {
-        HingeBending { k_weft: k, k_bias: k, k_warp: k }
+        HingeBending::isotropic(k)
     }
 
     #[test]
     fn the_starting_loop_has_the_clamp_distance_and_the_strip_length() {
         assert!((mean_cos(0.0) - 1.0).abs() < 1e-15 && mean_cos(2.404_825_557_695_773).abs() < 1e-12);
-        let test = PearLoopTest::new(Direction::Weft, 0.1, 0.02, 0.2, 0.004);
+        let test = PearLoopTest::new(Direction::Weft, 0.1, 0.2, 0.004);
         let x = test.initial_loop(0.02).expect("a loop");
         let ends: Vec<f64> = x
             .iter()
-            .zip(&test.arc)
-            .filter(|(_, (s, b))| (s.abs() < 1e-12 || (s - 0.1).abs() < 1e-12) && b.abs() < 0.011)
+            .zip(&test.strip.arc)
+            .filter(|(_, (s, _))| s.abs() < 1e-12 || (s - 0.1).abs() < 1e-12)
             .map(|(p, _)| p.x)
             .collect();
         let (lo, hi) =
@@ -251,7 +215,7 @@ mod tests {
 
     #[test]
     fn a_stiffer_or_lighter_strip_sags_less() {
-        let test = PearLoopTest::new(Direction::Weft, 0.1, 0.02, 0.2, 0.005);
+        let test = PearLoopTest::new(Direction::Weft, 0.1, 0.2, 0.005);
         let distances = [0.01, 0.03];
         let soft = test.run(&knit_membrane(), &bending(2e-6), &distances).expect("equilibrium");
         let stiff = test.run(&knit_membrane(), &bending(2e-5), &distances).expect("equilibrium");
@@ -262,9 +226,20 @@ mod tests {
         // Clamps farther apart make a wider, rounder loop.
         assert!(soft[1].width_m > soft[0].width_m && soft[1].aspect_ratio < soft[0].aspect_ratio);
         // Without weight the shape is the elastica's and does not depend on the stiffness.
-        let weightless = PearLoopTest::new(Direction::Weft, 0.1, 0.02, 1e-9, 0.005);
+        let weightless = PearLoopTest::new(Direction::Weft, 0.1, 1e-9, 0.005);
         let a = weightless.run(&knit_membrane(), &bending(2e-6), &[0.02]).expect("equilibrium")[0];
         let b = weightless.run(&knit_membrane(), &bending(2e-5), &[0.02]).expect("equilibrium")[0];
         assert!((a.aspect_ratio - b.aspect_ratio).abs() < 0.01 * a.aspect_ratio, "{a:?} vs {b:?}");
+    }
+
+    #[test]
+    fn a_uniform_rest_curvature_does_not_change_the_loop() {
+        let test = PearLoopTest::new(Direction::Warp, 0.1, 0.25, 0.005);
+        let flat = test.run(&knit_membrane(), &bending(1e-6), &[0.005, 0.02]).expect("equilibrium");
+        let curled = HingeBending { rest_curvature_warp: 40.0, rest_curvature_bias: 40.0, ..bending(1e-6) };
+        let curled = test.run(&knit_membrane(), &curled, &[0.005, 0.02]).expect("equilibrium");
+        for (f, c) in flat.iter().zip(&curled) {
+            assert!((f.aspect_ratio - c.aspect_ratio).abs() < 0.01 * f.aspect_ratio, "{f:?} vs {c:?}");
+        }
     }
 }

@@ -10,6 +10,10 @@
 //! 4. Check: the fitted material re-simulated on a mesh twice as fine; the largest change of a
 //!    simulated reading is reported (the thesis found 2% on twice-subdivided meshes).
 //!
+//! 5. Bending, when the set has bending tests: the thesis' anisotropic hinge bending fitted to
+//!    them with the fitted membrane ([`crate::bending_fit`]), and its uniform targets
+//!    `{κ, σ_κ}`.
+//!
 //! Errors (Sec. 6.3.1): per direction, the RMS of `f_sim - f` over the mean measured force,
 //! and the RMS of `c_sim - c` over the mean measured compression (at least 0.01); (6.2)'s
 //! weights `w_s`, `w_c` are these normalizations, so the fit minimizes the reported errors.
@@ -21,6 +25,9 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_shell::{Stiffening, StvkNeoHookean};
 
+use crate::bending_fit::{
+    BendingFit, BendingFitError, BendingModel, BendingTarget, BendingTest, BendingTests, fit_bending,
+};
 use crate::lm::{LmReport, LmSettings, minimize};
 use crate::measure::{Direction, MeasurementSet, Specimen};
 use crate::swatch::{SimulatedReading, SwatchTest};
@@ -130,6 +137,65 @@ pub struct ShellFit {
     pub wall_time_s: f64,
     /// The uniform targets (6.3): every direction over the tested stretch range.
     pub uniform_targets: Vec<UniformTarget>,
+    /// The bending fit (Sec. 6.3.2), when the set has bending tests.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bending: Option<ShellBending>,
+}
+
+/// The bending part of a shell fit (Sec. 6.3.2): the thesis' anisotropic hinge bending
+/// `{k_weft, k_bias, k_warp}` fitted to the bending tests with the fitted membrane, and the
+/// uniform bending targets `{κ, σ_κ}` per direction.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ShellBending {
+    /// The fit (absent when it could not run; see `note`).
+    pub fit: Option<BendingFit>,
+    /// Why there is no fit.
+    pub note: Option<String>,
+    /// The uniform bending targets, 7 per direction.
+    pub uniform_targets: Vec<BendingTarget>,
+    /// The tests, in file order (pear loops, then cantilevers).
+    pub tests: Vec<BendingTest>,
+    /// Their measured readings.
+    pub measured: Vec<f64>,
+}
+
+/// Uniform bending targets per direction.
+const BENDING_TARGETS_PER_DIRECTION: usize = 7;
+
+/// The bending fit of `set` with `membrane`, if the set has bending tests.
+fn shell_bending(set: &MeasurementSet, membrane: &StvkNeoHookean, lm: &LmSettings) -> Option<ShellBending> {
+    let tests = match BendingTests::of_set(set, |_| true) {
+        Ok(tests) => tests,
+        Err(BendingFitError::NoTests) => return None,
+        Err(e) => {
+            return Some(ShellBending {
+                fit: None,
+                note: Some(e.to_string()),
+                uniform_targets: Vec::new(),
+                tests: Vec::new(),
+                measured: Vec::new(),
+            });
+        }
+    };
+    let unfitted = |note: String| ShellBending {
+        fit: None,
+        note: Some(note),
+        uniform_targets: Vec::new(),
+        tests: tests.tests.clone(),
+        measured: tests.measured.clone(),
+    };
+    Some(match fit_bending(&tests, membrane, BendingModel::Anisotropic, None, lm) {
+        Ok(fit) => ShellBending {
+            uniform_targets: tests
+                .uniform_targets(membrane, &fit.bending, BENDING_TARGETS_PER_DIRECTION)
+                .unwrap_or_default(),
+            fit: Some(fit),
+            note: None,
+            tests: tests.tests.clone(),
+            measured: tests.measured.clone(),
+        },
+        Err(e) => unfitted(e.to_string()),
+    })
 }
 
 /// Format tag of [`ShellFit`] files.
@@ -474,6 +540,7 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         vertices: problem.tests.iter().map(SwatchTest::vertex_count).max().unwrap_or(0),
         wall_time_s: started.elapsed().as_secs_f64(),
         uniform_targets: uniform_targets(&material, data, settings.plan.per_direction),
+        bending: shell_bending(set, &material, &settings.lm),
         simulated: fitted.into_iter().flatten().collect(),
         targets,
     })
@@ -514,7 +581,7 @@ fn uniform_targets(material: &StvkNeoHookean, data: &[DirectionData], n: usize) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synth::{SynthPlan, synthesize};
+    use crate::synth::{GroundTruth, SynthPlan, synthesize};
 
     fn truth() -> StvkNeoHookean {
         StvkNeoHookean {
@@ -539,7 +606,7 @@ mod tests {
     #[test]
     fn the_fit_recovers_the_membrane_behind_clean_clamped_swatch_data() {
         let plan = SynthPlan { spacing_m: 0.01, ..SynthPlan::new("truth", 0.3) };
-        let set = synthesize(&truth(), &plan).expect("simulates");
+        let set = synthesize(&GroundTruth::of_membrane(truth()), &plan).expect("simulates");
         let fit = fit_shell(&set, &settings()).expect("fits");
         assert!(
             fit.errors.force < 0.01 && fit.errors.compression.expect("measured") < 0.02,
@@ -565,7 +632,7 @@ mod tests {
             spacing_m: 0.01,
             ..SynthPlan::new("no bias", 0.3)
         };
-        let set = synthesize(&truth(), &plan).expect("simulates");
+        let set = synthesize(&GroundTruth::of_membrane(truth()), &plan).expect("simulates");
         let fit =
             fit_shell(&set, &ShellFitSettings { model: MembraneModel::Stvk, ..settings() }).expect("fits");
         assert_eq!(fit.unconstrained, vec!["k_ss".to_string()]);

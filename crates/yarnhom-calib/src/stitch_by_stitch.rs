@@ -241,7 +241,10 @@ pub fn import(path: &Path, every: usize) -> Result<Import> {
         stretch.extend(points);
         reports.push(report);
     }
-    Ok(Import { set: MeasurementSet { fabric, stretch, bending: Vec::new() }, videos: reports })
+    Ok(Import {
+        set: MeasurementSet { fabric, stretch, bending: Vec::new(), cantilever: Vec::new() },
+        videos: reports,
+    })
 }
 
 /// Import the files of one fabric (say its `-x` and `-y` files) into one measurement set: each

@@ -1,12 +1,17 @@
 //! Synthetic measurement sets: the clamped stretch tests of a known membrane simulated
 //! ([`crate::swatch`]) at evenly spaced stretches, with Gaussian noise on the force and the
-//! compression, written as a real set would be. Fits run on these must recover the membrane,
-//! and a diagnosis must find the effect hidden in it ([`HiddenEffect`], [`ground_truth`]).
+//! compression, and, if asked for, its bending tests (pear loops and cantilevers on both faces,
+//! [`crate::bending_fit`]) with noise on their readings; written as a real set would be. Fits
+//! run on these must recover the truth, and a diagnosis must find the effect hidden in it
+//! ([`HiddenEffect`], [`ground_truth`]).
 
 use nalgebra::Vector2;
-use yarnhom_shell::{Stiffening, StvkNeoHookean};
+use yarnhom_shell::{HingeBending, Stiffening, StvkNeoHookean};
 
-use crate::measure::{Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch};
+use crate::bending_fit::{BendingTests, group_mean_magnitudes};
+use crate::measure::{
+    BendingPoint, CantileverPoint, Direction, Fabric, Face, MeasurementSet, Phase, StretchPoint, Swatch,
+};
 use crate::swatch::{SimulatedReading, SwatchError, SwatchTest};
 
 /// An effect hidden in a synthetic set, beyond the plain anisotropic StVK base.
@@ -21,13 +26,38 @@ pub enum HiddenEffect {
     /// Unloading readings below loading: a friction force `2 h f_max` opposes the unloading
     /// swatch (a constant offset, not the multiplicative form the diagnosis fits).
     FrictionHysteresis,
+    /// The fabric curls: a rest curvature in every direction.
+    RestCurvature,
+    /// Bending stiffness differs by direction (weft stiffer than warp).
+    AnisotropicBending,
 }
 
-/// The truth of a synthetic set: a knit-like anisotropic StVK (weft 60, warp 25 J/m²) with
-/// `effect` at `strength` (1: clearly visible at 2% noise), and the friction `h` of the
-/// unloading readings (0 without hysteresis).
-pub fn ground_truth(effect: HiddenEffect, strength: f64) -> (StvkNeoHookean, f64) {
-    let base = StvkNeoHookean {
+/// The truth of a synthetic set.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct GroundTruth {
+    /// The membrane (6.1).
+    pub membrane: StvkNeoHookean,
+    /// Friction `h` of the unloading readings (0 without hysteresis).
+    pub unload_friction: f64,
+    /// The hinge bending (6.4).
+    pub bending: HingeBending,
+}
+
+impl GroundTruth {
+    /// `membrane` with no friction and the base truth's isotropic flat bending.
+    pub fn of_membrane(membrane: StvkNeoHookean) -> Self {
+        Self { membrane, unload_friction: 0.0, bending: HingeBending::isotropic(BASE_BENDING_J) }
+    }
+}
+
+/// Bending stiffness of the base truth (J): a soft knit, whose pear loop responds to it.
+const BASE_BENDING_J: f64 = 1e-6;
+
+/// The truth of a synthetic set: a knit-like anisotropic StVK (weft 60, warp 25 J/m²) and an
+/// isotropic, flat bending of 1e-6 J, with `effect` at `strength` (1: clearly visible at 2%
+/// noise).
+pub fn ground_truth(effect: HiddenEffect, strength: f64) -> GroundTruth {
+    let membrane = StvkNeoHookean {
         k_xx: 60.0,
         k_xy: 6.0,
         k_yy: 25.0,
@@ -36,23 +66,72 @@ pub fn ground_truth(effect: HiddenEffect, strength: f64) -> (StvkNeoHookean, f64
         k_n2: 0.0,
         stiffening: None,
     };
+    let base =
+        GroundTruth { membrane, unload_friction: 0.0, bending: HingeBending::isotropic(BASE_BENDING_J) };
     match effect {
-        HiddenEffect::None => (base, 0.0),
-        HiddenEffect::AreaPreservation => {
-            (StvkNeoHookean { k_n1: 40.0 * strength, k_n2: 40.0 * strength, ..base }, 0.0)
-        }
-        HiddenEffect::BiphasicStretch => (
-            StvkNeoHookean {
+        HiddenEffect::None => base,
+        HiddenEffect::AreaPreservation => GroundTruth {
+            membrane: StvkNeoHookean { k_n1: 40.0 * strength, k_n2: 40.0 * strength, ..membrane },
+            ..base
+        },
+        HiddenEffect::BiphasicStretch => GroundTruth {
+            membrane: StvkNeoHookean {
                 stiffening: Some(Stiffening {
                     k_weft: 240.0 * strength,
                     k_warp: 100.0 * strength,
                     onset: 0.08,
                 }),
-                ..base
+                ..membrane
             },
-            0.0,
-        ),
-        HiddenEffect::FrictionHysteresis => (base, 0.08 * strength),
+            ..base
+        },
+        HiddenEffect::FrictionHysteresis => GroundTruth { unload_friction: 0.08 * strength, ..base },
+        HiddenEffect::RestCurvature => {
+            let curl = 25.0 * strength;
+            GroundTruth {
+                bending: HingeBending {
+                    rest_curvature_weft: curl,
+                    rest_curvature_bias: curl,
+                    rest_curvature_warp: curl,
+                    ..base.bending
+                },
+                ..base
+            }
+        }
+        HiddenEffect::AnisotropicBending => GroundTruth {
+            bending: HingeBending::anisotropic(
+                BASE_BENDING_J * (1.0 + 3.0 * strength),
+                BASE_BENDING_J * (1.0 + 1.5 * strength),
+                BASE_BENDING_J,
+            ),
+            ..base
+        },
+    }
+}
+
+/// The bending tests of a synthetic set.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BendingPlan {
+    /// Pear-loop clamp distances (m), per direction.
+    pub clamp_distances_m: Vec<f64>,
+    /// Cantilever overhangs (m), per direction and face.
+    pub overhangs_m: Vec<f64>,
+    /// Standard deviation of the reading noise, as a fraction of the mean clean reading of its
+    /// test and direction.
+    pub noise: f64,
+}
+
+impl Default for BendingPlan {
+    /// The thesis' 7 clamp distances from 0.3 to 3.4 cm (Sec. 6.3.2), and 7 overhangs from 0.8
+    /// to 3.2 cm, around the bending length `(2k/ρg)^⅓` of soft knits (about 1 cm), where the
+    /// cantilever is sensitive (ASTM D1388 reads the overhang whose tip dips 41.5°, about twice
+    /// the bending length); no noise.
+    fn default() -> Self {
+        Self {
+            clamp_distances_m: (0..7).map(|k| 0.003 + 0.031 * k as f64 / 6.0).collect(),
+            overhangs_m: (0..7).map(|k| 0.008 + 0.004 * k as f64).collect(),
+            noise: 0.0,
+        }
     }
 }
 
@@ -71,8 +150,10 @@ pub struct SynthPlan {
     pub force_noise_n: f64,
     /// Standard deviation of the compression noise.
     pub compression_noise: f64,
-    /// Unloading readings too, with this friction `h` (`None`: loading only).
-    pub unload_friction: Option<f64>,
+    /// Unloading readings too (with the truth's friction).
+    pub unload: bool,
+    /// Bending tests too (the fabric's areal density must be set).
+    pub bending: Option<BendingPlan>,
     /// Seed of the noise.
     pub seed: u64,
     /// Mesh edge length (m).
@@ -94,15 +175,29 @@ impl SynthPlan {
             readings: 60,
             force_noise_n: 0.0,
             compression_noise: 0.0,
-            unload_friction: None,
+            unload: false,
+            bending: None,
             seed: 1,
             spacing_m: 0.005,
         }
     }
 }
 
-/// The readings of `material` under `plan`: loading, then unloading if asked for.
-pub fn synthesize(material: &StvkNeoHookean, plan: &SynthPlan) -> Result<MeasurementSet, SwatchError> {
+/// Why a synthetic set could not be made.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SynthError {
+    /// A stretch test failed.
+    #[error(transparent)]
+    Swatch(#[from] SwatchError),
+    /// A bending test has no equilibrium, or the plan has no areal density.
+    #[error("the bending tests of the truth cannot be simulated: {0}")]
+    Bending(String),
+}
+
+/// The readings of `truth` under `plan`: loading, then unloading and bending tests if asked
+/// for.
+pub fn synthesize(truth: &GroundTruth, plan: &SynthPlan) -> Result<MeasurementSet, SynthError> {
+    let material = &truth.membrane;
     let mut noise = Normal::new(plan.seed);
     let mut stretch = Vec::new();
     for (&direction, &s_max) in plan.directions.iter().zip(&plan.max_stretch) {
@@ -121,7 +216,8 @@ pub fn synthesize(material: &StvkNeoHookean, plan: &SynthPlan) -> Result<Measure
         };
         let load: Vec<StretchPoint> = readings.iter().map(|r| point(r, r.force_n, Phase::Load)).collect();
         stretch.extend(load);
-        if let Some(h) = plan.unload_friction {
+        if plan.unload {
+            let h = truth.unload_friction;
             let unload: Vec<StretchPoint> = readings
                 .iter()
                 .rev()
@@ -131,7 +227,52 @@ pub fn synthesize(material: &StvkNeoHookean, plan: &SynthPlan) -> Result<Measure
             stretch.extend(unload);
         }
     }
-    Ok(MeasurementSet { fabric: plan.fabric.clone(), stretch, bending: Vec::new() })
+    let mut set =
+        MeasurementSet { fabric: plan.fabric.clone(), stretch, bending: Vec::new(), cantilever: Vec::new() };
+    if let Some(bending) = &plan.bending {
+        add_bending_tests(&mut set, truth, plan, bending, &mut noise)?;
+    }
+    Ok(set)
+}
+
+/// Simulate the bending tests of `bending` along the plan's directions and add them to `set`.
+fn add_bending_tests(
+    set: &mut MeasurementSet,
+    truth: &GroundTruth,
+    plan: &SynthPlan,
+    bending: &BendingPlan,
+    noise: &mut Normal,
+) -> Result<(), SynthError> {
+    for &direction in &plan.directions {
+        set.bending.extend(bending.clamp_distances_m.iter().map(|&clamp_distance_m| BendingPoint {
+            direction,
+            clamp_distance_m,
+            aspect_ratio: 1.0,
+        }));
+        for face in Face::ALL {
+            set.cantilever.extend(bending.overhangs_m.iter().map(|&overhang_m| CantileverPoint {
+                direction,
+                face,
+                overhang_m,
+                tip_drop_m: 0.0,
+            }));
+        }
+    }
+    let tests = BendingTests::of_set(set, |_| true).map_err(|e| SynthError::Bending(e.to_string()))?;
+    let clean = tests
+        .simulate(&truth.membrane, &truth.bending)
+        .ok_or_else(|| SynthError::Bending("a test has no equilibrium".into()))?;
+    let scale = group_mean_magnitudes(&tests.tests, &clean);
+    let noisy: Vec<f64> =
+        clean.iter().zip(&scale).map(|(r, m)| r + bending.noise * m * noise.sample()).collect();
+    let (pear, cantilever) = noisy.split_at(set.bending.len());
+    for (p, r) in set.bending.iter_mut().zip(pear) {
+        p.aspect_ratio = *r;
+    }
+    for (p, r) in set.cantilever.iter_mut().zip(cantilever) {
+        p.tip_drop_m = r.clamp(-p.overhang_m, p.overhang_m);
+    }
+    Ok(())
 }
 
 /// Standard normal samples: splitmix64 uniforms through Box-Muller (reproducible per seed on

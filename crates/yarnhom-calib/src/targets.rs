@@ -173,6 +173,7 @@ mod tests {
             },
             stretch: points,
             bending: vec![],
+            cantilever: vec![],
         }
     }
 

@@ -5,13 +5,17 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use plotters::prelude::*;
-use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
+use yarnhom_calib::bending_fit::BendingTest;
+use yarnhom_calib::diagnose::{BendingTrack, CauseId, DiagnoseSettings, Diagnosis, diagnose};
 use yarnhom_calib::lm::LmSettings;
-use yarnhom_calib::measure::{Direction, MeasurementSet, Phase};
+use yarnhom_calib::measure::{Direction, Face, MeasurementSet, Phase};
 use yarnhom_calib::pear_loop::PearLoopTest;
-use yarnhom_calib::shell_fit::{MembraneModel, ShellFit, ShellFitSettings, fit_shell};
+use yarnhom_calib::shell_fit::{MembraneModel, ShellBending, ShellFit, ShellFitSettings, fit_shell};
 use yarnhom_calib::swatch::SimulatedReading;
-use yarnhom_calib::synth::{HiddenEffect, SynthPlan, ground_truth, synthesize};
+use yarnhom_calib::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, synthesize};
+
+/// Areal density of synthetic sets with bending tests (kg/m²): a mid-weight knit.
+const SYNTH_AREAL_DENSITY_KG_M2: f64 = 0.25;
 use yarnhom_calib::targets::{Target, TargetPlan};
 
 use yarnhom_shell::HingeBending;
@@ -53,15 +57,16 @@ pub struct PearLoopArgs {
     /// Free length between the clamps (m).
     #[arg(long, default_value_t = 0.10)]
     pub length: f64,
-    /// Strip width (m).
-    #[arg(long, default_value_t = 0.06)]
-    pub width: f64,
     /// Areal density (kg/m²).
     #[arg(long)]
     pub density: f64,
     /// Hinge stiffnesses `k_weft,k_bias,k_warp` (J), or one value for all.
     #[arg(long, value_delimiter = ',', num_args = 1..=3, required = true)]
     pub bending: Vec<f64>,
+    /// Rest curvatures `weft,bias,warp` (1/m), or one value for all; positive curls towards
+    /// the face that is up when the strip lies flat, the way the loop's bulb bends.
+    #[arg(long, value_delimiter = ',', num_args = 1..=3, default_value = "0")]
+    pub rest_curvature: Vec<f64>,
     /// The membrane: a `shell-fit.json` of `calibrate shell` (default: a knit-like anisotropic
     /// StVK, 60 / 25 J/m²).
     #[arg(long)]
@@ -112,6 +117,8 @@ pub enum EffectArg {
     AreaPreservation,
     BiphasicStretch,
     FrictionHysteresis,
+    RestCurvature,
+    AnisotropicBending,
 }
 
 #[derive(Debug, Args)]
@@ -134,7 +141,13 @@ pub struct SynthArgs {
     /// Largest stretch of every direction.
     #[arg(long, default_value_t = 0.4)]
     pub max_stretch: f64,
-    /// Also write the ground truth (membrane and friction) as JSON here.
+    /// Also write the bending tests: pear loops (7 clamp distances, 0.3 to 3.4 cm) and
+    /// cantilevers on both faces (7 overhangs, 0.8 to 3.2 cm) per direction, with the same
+    /// relative noise; the swatch's areal density is set to 0.25 kg/m². Implied by the bending
+    /// effects.
+    #[arg(long)]
+    pub bending_tests: bool,
+    /// Also write the ground truth (membrane, friction, bending) as JSON here.
     #[arg(long)]
     pub truth: Option<PathBuf>,
 }
@@ -216,8 +229,18 @@ fn shell(args: ShellArgs) -> Result<Outcome> {
     let svg = args.output.join("shell-fit.svg");
     std::fs::write(&svg, plot_shell_fit(&set, &fit)?)
         .with_context(|| format!("cannot write {}", svg.display()))?;
+    let mut written = format!("{} and {}", json.display(), svg.display());
+    if let Some(ShellBending { fit: Some(bending), tests, measured, .. }) = &fit.bending {
+        let path = args.output.join("bending.svg");
+        let fitted = vec![true; tests.len()];
+        let predictions = [("fitted".to_string(), bending.simulated.clone())];
+        let figure = BendingFigure { tests, measured, fitted: &fitted, predictions: &predictions };
+        std::fs::write(&path, plot_bending(&fit.fabric, figure)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+        written += &format!(" and {}", path.display());
+    }
     println!("{}", summary(&fit));
-    eprintln!("wrote {} and {}", json.display(), svg.display());
+    eprintln!("wrote {written}");
     Ok(Outcome::Success)
 }
 
@@ -255,6 +278,11 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
     write("report.md", report_markdown(&d))?;
     write("fit.svg", plot_diagnosis(&set, &d)?)?;
     write("residuals.svg", plot_residuals(&d)?)?;
+    let mut written = "report.json, report.md, fit.svg, residuals.svg".to_string();
+    if let Some(track) = &d.bending {
+        write("bending.svg", plot_bending(&d.fabric, track.into())?)?;
+        written += ", bending.svg";
+    }
     println!("cause: {} ({})", d.cause.id.as_str(), d.cause.explanation);
     for line in &d.cause.evidence {
         println!("  {line}");
@@ -263,7 +291,7 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
         "held-out error {:.4} -> {:.4}; {:.1} s",
         d.gain.heldout_error_before, d.gain.heldout_error_after, d.wall_time_s
     );
-    eprintln!("wrote {}/report.json, report.md, fit.svg, residuals.svg", args.output.display());
+    eprintln!("wrote {}/{written}", args.output.display());
     Ok(Outcome::Success)
 }
 
@@ -303,7 +331,7 @@ Held-out error (RMS normalized residual on targets not fitted): {} before, {} af
 | model | testable | parameters | fitted error | held-out error | criterion (AIC) | note |
 |---|---|---|---|---|---|---|
 ";
-    for m in std::iter::once(&d.base).chain(&d.candidates) {
+    for m in std::iter::once(&d.base).chain(d.bending.as_ref().map(|t| &t.base)).chain(&d.candidates) {
         md += &format!(
             "| {} | {} | {} | {} | {} | {} | {} |
 ",
@@ -316,7 +344,12 @@ Held-out error (RMS normalized residual on targets not fitted): {} before, {} af
             m.note.as_deref().unwrap_or("")
         );
     }
-    for (title, model) in [("Base parameters", Some(&d.base)), ("Extended parameters", d.extended.as_ref())] {
+    let bending_base = d.bending.as_ref().map(|t| &t.base);
+    for (title, model) in [
+        ("Base parameters", Some(&d.base)),
+        ("Bending base parameters", bending_base),
+        ("Extended parameters", d.extended.as_ref()),
+    ] {
         let Some(model) = model else { continue };
         md += &format!(
             "
@@ -363,14 +396,22 @@ fn synth(args: SynthArgs) -> Result<Outcome> {
         EffectArg::AreaPreservation => HiddenEffect::AreaPreservation,
         EffectArg::BiphasicStretch => HiddenEffect::BiphasicStretch,
         EffectArg::FrictionHysteresis => HiddenEffect::FrictionHysteresis,
+        EffectArg::RestCurvature => HiddenEffect::RestCurvature,
+        EffectArg::AnisotropicBending => HiddenEffect::AnisotropicBending,
     };
-    let (truth, friction) = ground_truth(effect, args.strength);
+    let truth = ground_truth(effect, args.strength);
     let name = args.output.file_name().and_then(|n| n.to_str()).unwrap_or("synthetic").to_string();
-    let clean_plan = SynthPlan {
+    let bending_tests = args.bending_tests
+        || matches!(effect, HiddenEffect::RestCurvature | HiddenEffect::AnisotropicBending);
+    let mut clean_plan = SynthPlan {
         readings: 120,
-        unload_friction: Some(friction),
+        unload: true,
+        bending: bending_tests.then(|| BendingPlan { noise: args.noise, ..BendingPlan::default() }),
         ..SynthPlan::new(&name, args.max_stretch)
     };
+    if bending_tests {
+        clean_plan.fabric.swatch.areal_density_kg_m2 = Some(SYNTH_AREAL_DENSITY_KG_M2);
+    }
     let clean = synthesize(&truth, &clean_plan)?;
     let mean = |f: &dyn Fn(&yarnhom_calib::StretchPoint) -> f64| {
         clean.stretch.iter().map(|p| f(p).abs()).sum::<f64>() / clean.stretch.len() as f64
@@ -384,26 +425,47 @@ fn synth(args: SynthArgs) -> Result<Outcome> {
     let set = synthesize(&truth, &plan)?;
     set.write(&args.output)?;
     if let Some(path) = &args.truth {
-        let truth_json = serde_json::json!({ "membrane": truth, "unload_friction_h": friction, "effect": format!("{:?}", args.effect) });
+        let truth_json = serde_json::json!({ "truth": truth, "effect": format!("{:?}", args.effect) });
         std::fs::write(path, serde_json::to_string_pretty(&truth_json)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
     }
-    eprintln!("wrote {} ({} readings)", args.output.display(), set.stretch.len());
+    eprintln!(
+        "wrote {} ({} stretch, {} pear-loop and {} cantilever readings)",
+        args.output.display(),
+        set.stretch.len(),
+        set.bending.len(),
+        set.cantilever.len()
+    );
     Ok(Outcome::Success)
 }
 
 fn pear_loop(args: PearLoopArgs) -> Result<Outcome> {
     let positive = |x: f64| x.is_finite() && x > 0.0;
     anyhow::ensure!(
-        positive(args.length) && positive(args.width) && positive(args.spacing),
-        "--length, --width and --spacing must be positive lengths in metres"
+        positive(args.length) && positive(args.spacing),
+        "--length and --spacing must be positive lengths in metres"
     );
     anyhow::ensure!(positive(args.density), "--density must be a positive areal density in kg/m²");
     anyhow::ensure!(args.bending.iter().all(|k| positive(*k)), "--bending stiffnesses must be positive (J)");
-    let bending = match args.bending[..] {
-        [k] => HingeBending { k_weft: k, k_bias: k, k_warp: k },
-        [k_weft, k_bias, k_warp] => HingeBending { k_weft, k_bias, k_warp },
-        _ => anyhow::bail!("--bending takes one stiffness or three (k_weft,k_bias,k_warp)"),
+    let per_direction = |values: &[f64], option: &str| match *values {
+        [v] => Ok([v; 3]),
+        [weft, bias, warp] => Ok([weft, bias, warp]),
+        _ => Err(anyhow::anyhow!("{option} takes one value or three (weft,bias,warp)")),
+    };
+    let [k_weft, k_bias, k_warp] = per_direction(&args.bending, "--bending")?;
+    let [rest_curvature_weft, rest_curvature_bias, rest_curvature_warp] =
+        per_direction(&args.rest_curvature, "--rest-curvature")?;
+    anyhow::ensure!(
+        args.rest_curvature.iter().all(|k| k.is_finite()),
+        "--rest-curvature must be finite (1/m)"
+    );
+    let bending = HingeBending {
+        k_weft,
+        k_bias,
+        k_warp,
+        rest_curvature_weft,
+        rest_curvature_bias,
+        rest_curvature_warp,
     };
     let membrane = match &args.membrane {
         Some(path) => {
@@ -413,9 +475,9 @@ fn pear_loop(args: PearLoopArgs) -> Result<Outcome> {
                 .with_context(|| format!("{}: not a shell-fit.json", path.display()))?;
             fit.material
         }
-        None => ground_truth(HiddenEffect::None, 0.0).0,
+        None => ground_truth(HiddenEffect::None, 0.0).membrane,
     };
-    let test = PearLoopTest::new(args.direction, args.length, args.width, args.density, args.spacing);
+    let test = PearLoopTest::new(args.direction, args.length, args.density, args.spacing);
     let readings = test.run(&membrane, &bending, &args.distances)?;
     println!("clamp_distance_m,height_m,width_m,aspect_ratio");
     for r in readings {
@@ -474,7 +536,42 @@ fn summary(fit: &ShellFit) -> String {
         "  {} Levenberg-Marquardt iterations, {} swatch simulations, {:.1} s; {} vertices per swatch; {refinement}",
         fit.optimizer.iterations, fit.optimizer.evaluations, fit.wall_time_s, fit.vertices,
     ));
+    lines.extend(bending_summary(fit.bending.as_ref()));
     lines.join("\n")
+}
+
+/// The bending lines of the summary: stiffnesses and errors per direction, or why there are
+/// none.
+fn bending_summary(bending: Option<&ShellBending>) -> Vec<String> {
+    let Some(bending) = bending else { return vec!["bending: no bending tests in the set".into()] };
+    let Some(fit) = &bending.fit else {
+        return vec![format!("bending: not fitted: {}", bending.note.as_deref().unwrap_or("unknown reason"))];
+    };
+    let b = &fit.bending;
+    let mut lines = vec![
+        format!(
+            "bending (6.4): k_weft {:.3e} k_bias {:.3e} k_warp {:.3e} J ({} simulations of the {} tests)",
+            b.k_weft,
+            b.k_bias,
+            b.k_warp,
+            fit.evaluations,
+            bending.tests.len()
+        ),
+        "  direction  pear-loop error  cantilever error".into(),
+    ];
+    for e in &fit.by_direction {
+        lines.push(format!(
+            "  {:<9}  {:>15}  {:>16}",
+            e.direction.as_str(),
+            percent(e.pear_loop),
+            percent(e.cantilever)
+        ));
+    }
+    lines.push(format!(
+        "  all        {:>15}  (thesis Sec. 6.3.2 pear-loop average: 5.61%)",
+        percent(Some(fit.error))
+    ));
+    lines
 }
 
 pub(crate) const MEASURED: RGBColor = RGBColor(0xB0, 0xB8, 0xC8);
@@ -504,9 +601,10 @@ pub(crate) struct Series {
     pub points: Vec<(f64, f64)>,
 }
 
-/// One chart of a figure: y against stretch.
+/// One chart of a figure: y against x (stretch unless said otherwise).
 pub(crate) struct Panel {
     pub title: String,
+    pub x_label: &'static str,
     pub y_label: String,
     pub series: Vec<Series>,
 }
@@ -537,7 +635,7 @@ fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel:
         .map_err(plot_error)?;
     chart
         .configure_mesh()
-        .x_desc("stretch")
+        .x_desc(panel.x_label)
         .y_desc(panel.y_label.as_str())
         .label_style((FONT, 12))
         .x_label_formatter(&|x| format_value(*x))
@@ -653,6 +751,7 @@ fn plot_shell_fit(set: &MeasurementSet, fit: &ShellFit) -> Result<String> {
                 }),
             );
             panels.push(Panel {
+                x_label: "stretch",
                 title: format!("{} {direction}: {}", fit.fabric, q.label()),
                 y_label: q.label().into(),
                 series: vec![
@@ -760,8 +859,86 @@ fn plot_diagnosis(set: &MeasurementSet, d: &Diagnosis) -> Result<String> {
                 });
             }
             panels.push(Panel {
+                x_label: "stretch",
                 title: format!("{} {direction}: {}", d.fabric, q.label()),
                 y_label: q.label().into(),
+                series,
+            });
+        }
+    }
+    plot_panels(&panels, directions.len())
+}
+
+/// The readings of bending tests and the models' simulations of them.
+struct BendingFigure<'a> {
+    tests: &'a [BendingTest],
+    measured: &'a [f64],
+    fitted: &'a [bool],
+    predictions: &'a [(String, Vec<f64>)],
+}
+
+impl<'a> From<&'a BendingTrack> for BendingFigure<'a> {
+    fn from(t: &'a BendingTrack) -> Self {
+        Self { tests: &t.tests, measured: &t.measured, fitted: &t.fitted, predictions: &t.predictions }
+    }
+}
+
+/// Bending tests: per direction, pear-loop aspect ratio against clamp distance and cantilever
+/// tip drop against overhang (both faces), measured (fitted filled, held out hollow) against
+/// the models (first black, second red).
+fn plot_bending(fabric: &str, track: BendingFigure<'_>) -> Result<String> {
+    let directions: Vec<Direction> =
+        Direction::ALL.into_iter().filter(|d| track.tests.iter().any(|t| t.direction() == *d)).collect();
+    let kinds: [(&str, &'static str, &str); 3] = [
+        ("pear loop", "clamp distance (m)", "aspect ratio"),
+        ("cantilever, face up", "overhang (m)", "tip drop (m)"),
+        ("cantilever, face down", "overhang (m)", "tip drop (m)"),
+    ];
+    let kind_of = |t: &BendingTest| match t {
+        BendingTest::PearLoop { .. } => 0,
+        BendingTest::Cantilever { face: Face::Up, .. } => 1,
+        BendingTest::Cantilever { face: Face::Down, .. } => 2,
+    };
+    let x_of = |t: &BendingTest| match t {
+        BendingTest::PearLoop { clamp_distance_m, .. } => *clamp_distance_m,
+        BendingTest::Cantilever { overhang_m, .. } => *overhang_m,
+    };
+    let mut panels = Vec::new();
+    for (k, (kind, x_label, y_label)) in kinds.iter().enumerate() {
+        if !track.tests.iter().any(|t| kind_of(t) == k) {
+            continue;
+        }
+        for &direction in &directions {
+            let mine: Vec<usize> = (0..track.tests.len())
+                .filter(|&i| kind_of(&track.tests[i]) == k && track.tests[i].direction() == direction)
+                .collect();
+            let mut sorted = mine.clone();
+            sorted.sort_by(|a, b| x_of(&track.tests[*a]).total_cmp(&x_of(&track.tests[*b])));
+            let measured = |fitted: bool| {
+                mine.iter()
+                    .filter(|&&i| track.fitted[i] == fitted)
+                    .map(|&i| (x_of(&track.tests[i]), track.measured[i]))
+                    .collect()
+            };
+            let mut series = vec![
+                Series { label: "measured, fitted".into(), mark: Mark::Dot(TARGET), points: measured(true) },
+                Series {
+                    label: "measured, held out".into(),
+                    mark: Mark::Ring(TARGET),
+                    points: measured(false),
+                },
+            ];
+            for ((id, simulated), colour) in track.predictions.iter().zip([BLACK, FITTED]) {
+                series.push(Series {
+                    label: id.clone(),
+                    mark: Mark::Line(colour),
+                    points: sorted.iter().map(|&i| (x_of(&track.tests[i]), simulated[i])).collect(),
+                });
+            }
+            panels.push(Panel {
+                title: format!("{fabric} {direction}: {kind}"),
+                x_label,
+                y_label: (*y_label).into(),
                 series,
             });
         }
@@ -798,6 +975,7 @@ fn plot_residuals(d: &Diagnosis) -> Result<String> {
                 });
             }
             panels.push(Panel {
+                x_label: "stretch",
                 title: format!("{} {direction}: {} residual", d.fabric, q.label()),
                 y_label: "(model - measured) / mean".into(),
                 series,

@@ -287,6 +287,7 @@ fn plot_yarn_fit(fit: &YarnFit) -> Result<String> {
                 .collect();
             let top = target.iter().chain(&yarn).map(|p| p.1).fold(0.0, f64::max);
             panels.push(Panel {
+                x_label: "stretch",
                 title: format!(
                     "{} {}: {}",
                     fit.fabric,

@@ -1,11 +1,11 @@
-//! `yarnhom calibrate shell` on a synthetic set whose membrane is known, and on bad input.
+//! `yarnhom calibrate` on synthetic sets whose truth is known, and on bad input.
 
 use std::path::Path;
 use std::process::{Command, Output};
 
 use yarnhom_calib::measure::Direction;
-use yarnhom_calib::synth::{SynthPlan, synthesize};
-use yarnhom_shell::StvkNeoHookean;
+use yarnhom_calib::synth::{BendingPlan, GroundTruth, SynthPlan, synthesize};
+use yarnhom_shell::{HingeBending, StvkNeoHookean};
 
 fn yarnhom(args: &[&str], cwd: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_yarnhom")).args(args).current_dir(cwd).output().expect("run yarnhom")
@@ -21,17 +21,26 @@ fn text(bytes: &[u8]) -> String {
 }
 
 #[test]
-fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() {
+fn calibrate_shell_recovers_a_known_membrane_and_bending_and_writes_its_report_and_figures() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let truth = known_membrane();
-    let plan = SynthPlan {
+    let truth = GroundTruth {
+        bending: HingeBending::anisotropic(3e-6, 2e-6, 1e-6),
+        ..GroundTruth::of_membrane(known_membrane())
+    };
+    let mut plan = SynthPlan {
         directions: vec![Direction::Weft, Direction::Warp],
         max_stretch: vec![0.25, 0.4],
         force_noise_n: 0.01,
         compression_noise: 0.001,
         spacing_m: 0.01,
+        bending: Some(BendingPlan {
+            clamp_distances_m: vec![0.003, 0.013, 0.024, 0.034],
+            overhangs_m: vec![0.01, 0.018, 0.026],
+            noise: 0.0,
+        }),
         ..SynthPlan::new("synthetic", 0.3)
     };
+    plan.fabric.swatch.areal_density_kg_m2 = Some(0.25);
     synthesize(&truth, &plan).expect("simulates").write(&dir.path().join("set")).expect("writes");
     let o = yarnhom(
         &["calibrate", "shell", "set", "-o", "out", "--spacing", "0.01", "--targets", "4"],
@@ -39,7 +48,7 @@ fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() 
     );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let summary = text(&o.stdout);
-    for expected in ["weft", "warp", "mean", "not constrained by the data (held): k_ss", "17.6%"] {
+    for expected in ["weft", "warp", "mean", "not constrained by the data (held): k_ss", "17.6%", "5.61%"] {
         assert!(summary.contains(expected), "missing '{expected}' in:\n{summary}");
     }
     let report: serde_json::Value =
@@ -51,6 +60,14 @@ fn calibrate_shell_recovers_a_known_membrane_and_writes_its_report_and_figure() 
     assert!((k_xx / 80.0 - 1.0).abs() < 0.1, "k_xx {k_xx}");
     let svg = std::fs::read_to_string(dir.path().join("out/shell-fit.svg")).expect("svg");
     assert!(svg.contains("synthetic warp: compression"), "figure has a panel per direction and quantity");
+    let bending = &report["bending"]["fit"];
+    let k = |name: &str| bending["bending"][name].as_f64().expect("a stiffness");
+    assert!((k("k_weft") / 3e-6 - 1.0).abs() < 0.1 && (k("k_warp") / 1e-6 - 1.0).abs() < 0.1, "{bending}");
+    assert!(bending["error"].as_f64().expect("error") < 0.02, "{bending}");
+    let targets = report["bending"]["uniform_targets"].as_array().expect("targets");
+    assert_eq!(targets.len(), 14, "7 {{κ, σ_κ}} targets per tested direction");
+    let svg = std::fs::read_to_string(dir.path().join("out/bending.svg")).expect("bending figure");
+    assert!(svg.contains("synthetic weft: cantilever, face down"), "a panel per test, face and direction");
 }
 
 #[test]
@@ -123,7 +140,7 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
 #[test]
 fn pear_loop_prints_a_loop_per_clamp_distance_and_refuses_impossible_ones() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let args = ["calibrate", "pear-loop", "--density", "0.25", "--width", "0.02", "--bending", "1e-6"];
+    let args = ["calibrate", "pear-loop", "--density", "0.25", "--bending", "1e-6"];
     let o = yarnhom(&[&args[..], &["--distances", "0.005,0.03"]].concat(), dir.path());
     assert!(o.status.success(), "{}", text(&o.stderr));
     let out = text(&o.stdout);
@@ -148,7 +165,10 @@ fn calibrate_yarn_estimates_a_yarn_model_in_shards_and_writes_its_artifacts() {
         ..SynthPlan::new("synthetic", 0.3)
     };
     let truth = known_membrane();
-    synthesize(&truth, &plan).expect("simulates").write(&dir.path().join("set")).expect("writes");
+    synthesize(&GroundTruth::of_membrane(truth), &plan)
+        .expect("simulates")
+        .write(&dir.path().join("set"))
+        .expect("writes");
     let small =
         ["--generations", "1", "--swarm-targets", "3", "--local-targets", "3", "--yarn-stiffness", "200"];
     // Two shards of a 4-particle swarm, then the local step from the better one.

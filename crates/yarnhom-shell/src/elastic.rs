@@ -130,7 +130,17 @@ impl ElasticModel {
                 .iter()
                 .map(|h| {
                     let m = h.vertices.map(|v| mesh.material[v as usize]);
-                    HingeRest::new(&m, anisotropic_stiffness(&(m[1] - m[0]), k.k_weft, k.k_bias, k.k_warp))
+                    let edge = m[1] - m[0];
+                    HingeRest::new(
+                        &m,
+                        anisotropic_stiffness(&edge, k.k_weft, k.k_bias, k.k_warp),
+                        anisotropic_stiffness(
+                            &edge,
+                            k.rest_curvature_weft,
+                            k.rest_curvature_bias,
+                            k.rest_curvature_warp,
+                        ),
+                    )
                 })
                 .collect(),
             None => Vec::new(),
@@ -278,7 +288,14 @@ mod tests {
                 k_n2: 0.1,
                 stiffening: None,
             },
-            HingeBending { k_weft: 1e-4, k_bias: 2e-4, k_warp: 3e-4 },
+            HingeBending {
+                k_weft: 1e-4,
+                k_bias: 2e-4,
+                k_warp: 3e-4,
+                rest_curvature_weft: 2.0,
+                rest_curvature_bias: -1.0,
+                rest_curvature_warp: 0.5,
+            },
         )
     }
 
@@ -343,7 +360,13 @@ mod tests {
         let rotation = nalgebra::Rotation3::from_euler_angles(0.3, -0.7, 1.1);
         let moved: Vec<_> = x.iter().map(|p| rotation * p + Vector3::new(1.0, -2.0, 0.5)).collect();
         assert!((model.energy(&x) - model.energy(&moved)).abs() < 1e-12);
-        assert!(model.energy(&mesh.flat_positions()).abs() < 1e-15);
+        // The material curls at rest: flat costs bending energy, unless it is flat at rest.
+        assert!(model.energy(&mesh.flat_positions()) > 0.0);
+        let mut flat_at_rest = stvk();
+        flat_at_rest.hinge_bending =
+            flat_at_rest.hinge_bending.map(|b| HingeBending::anisotropic(b.k_weft, b.k_bias, b.k_warp));
+        let flat_model = ElasticModel::new(mesh.clone(), flat_at_rest);
+        assert!(flat_model.energy(&mesh.flat_positions()).abs() < 1e-15);
     }
 
     #[test]

@@ -1,10 +1,13 @@
-//! Edge-hinge bending energy, thesis eq. (6.4):
-//! `E = k_θ κ² A_e`, `κ = 3θ/H`, with exact gradient and Hessian.
+//! Edge-hinge bending energy, thesis eq. (6.4), with an optional rest curvature `κ̄`:
+//! `E = k_θ (κ - κ̄)² A_e`, `κ = 3θ/H`, with exact gradient and Hessian (`κ̄ = 0` is (6.4)).
 //!
 //! A hinge is `[e0, e1, a, b]`: the interior edge `e0 → e1`, the far vertex `a` of the triangle
 //! `(e0, e1, a)` (counter-clockwise in material space) and the far vertex `b` of the triangle
-//! `(e1, e0, b)`. `θ` is the signed dihedral angle of [`crate::dihedral`] (rest angle 0: the
-//! material rest state is flat); its sign drops out of the energy.
+//! `(e1, e0, b)`. `θ` is the signed dihedral angle of [`crate::dihedral`]: positive when the
+//! surface folds towards its normal `(x_{e1} - x_{e0}) × (x_a - x_{e0})` (the side that is up
+//! for a counter-clockwise material frame laid flat). With `κ̄ = 0` (the material rest state is
+//! flat) the sign drops out of the energy; a rest curvature `κ̄ > 0` curls the surface
+//! towards its normal, so the rest angle is `θ̄ = κ̄ H / 3`.
 //!
 //! * `H` = mean of the rest altitudes of `a` and `b` over the edge;
 //! * `A_e = (A_a + A_b)/3`, a third of the two incident rest triangle areas. With this choice
@@ -32,12 +35,15 @@ pub struct HingeRest {
     pub mean_altitude: f64,
     /// `A_e = (A_a + A_b)/3`.
     pub area: f64,
+    /// The rest angle `θ̄ = κ̄ H / 3` of the rest curvature `κ̄`.
+    pub rest_angle: f64,
 }
 
 impl HingeRest {
-    /// From material coordinates `[e0, e1, a, b]`. Panics unless `(e0, e1, a)` and
-    /// `(e1, e0, b)` are both counter-clockwise and non-degenerate.
-    pub fn new(material: &[Vector2<f64>; 4], stiffness: f64) -> Self {
+    /// From material coordinates `[e0, e1, a, b]`, the stiffness `k_θ` and the rest curvature
+    /// `κ̄` (1/m). Panics unless `(e0, e1, a)` and `(e1, e0, b)` are both counter-clockwise and
+    /// non-degenerate.
+    pub fn new(material: &[Vector2<f64>; 4], stiffness: f64, rest_curvature: f64) -> Self {
         let [e0, e1, a, b] = material;
         let edge = e1 - e0;
         let double_area_a = edge.perp(&(a - e0));
@@ -47,10 +53,12 @@ impl HingeRest {
             "hinge triangles (e0, e1, a), (e1, e0, b) must be counter-clockwise"
         );
         let edge_len = edge.norm();
+        let mean_altitude = 0.5 * (double_area_a + double_area_b) / edge_len;
         Self {
             stiffness,
-            mean_altitude: 0.5 * (double_area_a + double_area_b) / edge_len,
+            mean_altitude,
             area: (double_area_a + double_area_b) / 6.0,
+            rest_angle: rest_curvature * mean_altitude / 3.0,
         }
     }
 
@@ -81,25 +89,26 @@ pub fn hinge_curvature(rest: &HingeRest, hinge: &[Vec3; 4]) -> f64 {
     rest.curvature_of(signed_dihedral_angle(hinge))
 }
 
-/// `E = k_θ κ² A_e`, eq. (6.4).
+/// `E = k_θ (κ - κ̄)² A_e`, eq. (6.4) with a rest curvature.
 pub fn hinge_energy(rest: &HingeRest, hinge: &[Vec3; 4]) -> f64 {
-    let angle = signed_dihedral_angle(hinge);
-    rest.angle_weight() * angle * angle
+    let excess = signed_dihedral_angle(hinge) - rest.rest_angle;
+    rest.angle_weight() * excess * excess
 }
 
-/// `E = W θ²`, `∇E = 2Wθ ∇θ`, `∇²E = 2W (∇θ ⊗ ∇θ + θ ∇²θ)`.
+/// `E = W (θ - θ̄)²`, `∇E = 2W(θ - θ̄) ∇θ`, `∇²E = 2W (∇θ ⊗ ∇θ + (θ - θ̄) ∇²θ)`.
 pub fn hinge_energy_with_derivatives(rest: &HingeRest, hinge: &[Vec3; 4]) -> HingeEnergy {
     let dihedral = signed_dihedral_angle_with_derivatives(hinge);
-    let (angle, weight) = (dihedral.angle, rest.angle_weight());
+    let (excess, weight) = (dihedral.angle - rest.rest_angle, rest.angle_weight());
     HingeEnergy {
-        energy: weight * angle * angle,
-        gradient: dihedral.gradient * (2.0 * weight * angle),
-        hessian: (dihedral.gradient * dihedral.gradient.transpose() + dihedral.hessian * angle)
+        energy: weight * excess * excess,
+        gradient: dihedral.gradient * (2.0 * weight * excess),
+        hessian: (dihedral.gradient * dihedral.gradient.transpose() + dihedral.hessian * excess)
             * (2.0 * weight),
     }
 }
 
-/// Bending stiffness of a hinge from its rest edge direction (material space).
+/// A hinge's bending stiffness (or rest curvature) from its rest edge direction (material
+/// space), interpolated between the weft, bias and warp values.
 ///
 /// Convention: material X is the weft and Y the warp direction; `k_weft` resists curvature
 /// along X (`II11`, bending the weft yarns), `k_warp` curvature along Y (`II22`), `k_bias`
@@ -134,7 +143,7 @@ mod tests {
         let left = Vector2::new(-along.y, along.x);
         let a = e0 + rng.uniform(-0.2, 1.2) * along + rng.uniform(0.3, 1.2) * left;
         let b = e0 + rng.uniform(-0.2, 1.2) * along - rng.uniform(0.3, 1.2) * left;
-        HingeRest::new(&[e0, e0 + along, a, b], rng.uniform(0.5, 2.0))
+        HingeRest::new(&[e0, e0 + along, a, b], rng.uniform(0.5, 2.0), rng.uniform(-2.0, 2.0))
     }
 
     #[test]
@@ -163,13 +172,41 @@ mod tests {
         let rest = random_rest(&mut rng);
         let hinge = random_hinge(&mut rng, 2.0);
         let kappa = hinge_curvature(&rest, &hinge);
-        assert_close(hinge_energy(&rest, &hinge), rest.stiffness * kappa * kappa * rest.area, 1e-12);
+        let rest_kappa = 3.0 * rest.rest_angle / rest.mean_altitude;
+        assert!(rest_kappa != 0.0);
+        let excess = kappa - rest_kappa;
+        assert_close(hinge_energy(&rest, &hinge), rest.stiffness * excess * excess * rest.area, 1e-12);
+    }
+
+    #[test]
+    fn a_rest_curvature_towards_the_normal_is_the_energy_minimum_of_a_cylinder() {
+        // The grid wrapped onto the cylinder curls towards +z, the normal of the flat grid.
+        let radius = 0.4;
+        let energy = |rest_curvature: f64| -> f64 {
+            cylinder_hinges(radius)
+                .iter()
+                .map(|(rest, x, m)| {
+                    let curled = HingeRest::new(m, rest.stiffness, rest_curvature);
+                    hinge_energy(&curled, x)
+                })
+                .sum()
+        };
+        // Axial hinges carry κ = 3/R: their rest curvature 3/R makes them free of energy.
+        let axial_only = |rest_curvature: f64| -> f64 {
+            cylinder_hinges(radius)
+                .iter()
+                .filter(|(_, _, m)| (m[1].x - m[0].x).abs() < 1e-12)
+                .map(|(rest, x, m)| hinge_energy(&HingeRest::new(m, rest.stiffness, rest_curvature), x))
+                .sum()
+        };
+        assert!(axial_only(3.0 / radius) < 1e-20);
+        assert!(energy(1.0 / radius) < energy(0.0) && energy(0.0) < energy(-1.0 / radius));
     }
 
     #[test]
     fn rest_data_of_unit_square_split() {
         let square = [(0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)].map(|(x, y)| Vector2::new(x, y));
-        let rest = HingeRest::new(&square, 2.0);
+        let rest = HingeRest::new(&square, 2.0, 0.0);
         assert_close(rest.mean_altitude, 0.5f64.sqrt(), 1e-15);
         assert_close(rest.area, 1.0 / 3.0, 1e-15);
     }
@@ -191,7 +228,7 @@ mod tests {
                     continue;
                 };
                 let material = [e0, e1, t[i], b].map(|v| grid.material[v]);
-                hinges.push((HingeRest::new(&material, 1.0), material.map(wrap), material));
+                hinges.push((HingeRest::new(&material, 1.0, 0.0), material.map(wrap), material));
             }
         }
         hinges

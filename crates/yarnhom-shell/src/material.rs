@@ -47,7 +47,8 @@ pub struct Stiffening {
     pub onset: f64,
 }
 
-/// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp.
+/// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp, and the rest
+/// curvatures `κ̄` (1/m) of a fabric that curls (0: flat at rest, the thesis' model).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct HingeBending {
     /// Bending that curves the weft (X) direction.
@@ -56,6 +57,34 @@ pub struct HingeBending {
     pub k_bias: f64,
     /// Bending that curves the warp (Y) direction.
     pub k_warp: f64,
+    /// Rest curvature of the weft direction, positive towards the fabric's normal (1/m).
+    #[serde(default)]
+    pub rest_curvature_weft: f64,
+    /// Rest curvature at 45° (1/m).
+    #[serde(default)]
+    pub rest_curvature_bias: f64,
+    /// Rest curvature of the warp direction (1/m).
+    #[serde(default)]
+    pub rest_curvature_warp: f64,
+}
+
+impl HingeBending {
+    /// Flat at rest, the same stiffness `k` (J) in every direction.
+    pub fn isotropic(k: f64) -> Self {
+        Self::anisotropic(k, k, k)
+    }
+
+    /// Flat at rest, stiffnesses per direction (J).
+    pub fn anisotropic(k_weft: f64, k_bias: f64, k_warp: f64) -> Self {
+        Self {
+            k_weft,
+            k_bias,
+            k_warp,
+            rest_curvature_weft: 0.0,
+            rest_curvature_bias: 0.0,
+            rest_curvature_warp: 0.0,
+        }
+    }
 }
 
 /// The energy density of the forms.
