@@ -43,10 +43,27 @@ pub struct LmReport {
 }
 
 /// Minimize `½ |r(p)|²` from `start`. `residuals` returns `None` where it cannot be evaluated;
-/// it must be evaluable at `start`.
+/// it must be evaluable at `start`. The Jacobian is taken by forward differences.
 pub fn minimize<F>(residuals: F, start: &[f64], settings: &LmSettings) -> Option<LmReport>
 where
     F: Fn(&[f64]) -> Option<Vec<f64>> + Sync,
+{
+    let jacobian =
+        |p: &DVector<f64>, r: &DVector<f64>| forward_jacobian(&residuals, p, r, settings.difference_step);
+    minimize_with_jacobian(&residuals, jacobian, start, settings)
+}
+
+/// [`minimize`] with the Jacobian from `jacobian(p, r(p))`: the matrix (`None` if it cannot be
+/// had) and the residual evaluations it took (counted in the report).
+pub fn minimize_with_jacobian<F, J>(
+    residuals: F,
+    jacobian: J,
+    start: &[f64],
+    settings: &LmSettings,
+) -> Option<LmReport>
+where
+    F: Fn(&[f64]) -> Option<Vec<f64>>,
+    J: Fn(&DVector<f64>, &DVector<f64>) -> (Option<DMatrix<f64>>, usize),
 {
     let mut p = DVector::from_column_slice(start);
     let mut r = DVector::from_vec(residuals(p.as_slice())?);
@@ -60,7 +77,7 @@ where
     let mut damping = 1e-3;
     while report.iterations < settings.max_iterations {
         report.iterations += 1;
-        let (jacobian, evaluations) = forward_jacobian(&residuals, &p, &r, settings.difference_step);
+        let (jacobian, evaluations) = jacobian(&p, &r);
         report.evaluations += evaluations;
         let Some(jacobian) = jacobian else { break };
         let normal = jacobian.transpose() * &jacobian;

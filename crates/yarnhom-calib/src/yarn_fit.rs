@@ -12,21 +12,31 @@
 
 use std::time::Instant;
 
+use nalgebra::{DMatrix, DVector};
+use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_artifacts::{Pattern, YarnModel};
 use yarnhom_geom::MacroStrain;
+use yarnhom_rve::assembly::RveState;
 use yarnhom_rve::homogenize::solve_at;
 use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, relax};
 use yarnhom_shell::StvkNeoHookean;
 
-use crate::lm::{LmSettings, minimize as levenberg_marquardt};
+use crate::lm::{LmSettings, minimize as levenberg_marquardt, minimize_with_jacobian};
 use crate::measure::{Direction, MeasurementSet};
 use crate::shell_fit::ShellFit;
 use crate::swarm::{SwarmReport, SwarmSettings, minimize as swarm};
 use crate::yarn_objective::{
-    COMFORT_FORCE_N, DirectionTargets, SimulatedCurve, YarnErrors, errors, residuals, simulate,
+    COMFORT_FORCE_N, DirectionTargets, SimulatedCurve, YarnErrors, errors, residual_jacobian, residuals,
+    simulate, simulate_direction_with_sensitivity,
 };
+
+/// Coordinate step of the parameter sensitivities ([`YarnProblem::evaluate_with_jacobian`]).
+pub const SENSITIVITY_STEP: f64 = 1e-4;
+
+/// Rounds of rest-shape estimation and Gauss-Newton in the Gauss-Newton local step.
+const GAUSS_NEWTON_ROUNDS: usize = 4;
 use crate::yarn_params::{YarnBasis, YarnParams};
 
 /// The local optimizer.
@@ -35,8 +45,13 @@ use crate::yarn_params::{YarnBasis, YarnParams};
 pub enum LocalSolver {
     /// COBYLA (Powell 1994), derivative-free, as the thesis.
     Cobyla,
-    /// Levenberg-Marquardt on the residuals of (6.11).
+    /// Levenberg-Marquardt on the residuals of (6.11), Jacobian by finite differences of whole
+    /// evaluations.
     LevenbergMarquardt,
+    /// Gauss-Newton / Levenberg-Marquardt with the Jacobian from the parameter sensitivities of
+    /// the tile's equilibrium ([`YarnProblem::evaluate_with_jacobian`]), alternated with the
+    /// rest-shape estimation: each round holds the rest shape estimated at its start.
+    GaussNewton,
     /// No local step (the swarm's best is the result).
     None,
 }
@@ -213,16 +228,80 @@ impl YarnProblem {
 
     /// Estimate the rest shape for the parameters at `x`, then simulate the tile at `targets`.
     pub fn evaluate(&self, x: &[f64], targets: &[DirectionTargets]) -> Result<Evaluation, YarnFitError> {
-        let (params, model) = self.model(x);
+        let (evaluation, _, _) = self.evaluate_on(&self.rest_shape(x)?, x, targets)?;
+        Ok(evaluation)
+    }
+
+    /// The rest shape estimated for the parameters at `x` (Sec. 6.5.2).
+    pub fn rest_shape(&self, x: &[f64]) -> Result<Pattern, YarnFitError> {
         let options = RelaxOptions {
             method: RelaxMethod::Estimation { max_length_change: self.rest.max_length_change },
             max_resets: self.rest.max_resets,
             ..RelaxOptions::default()
         };
-        let (rest_pattern, _) = relax(&self.pattern, &model, &options, &mut |_| {})
+        let (rest_pattern, _) = relax(&self.pattern, &self.model(x).1, &options, &mut |_| {})
             .map_err(|e| YarnFitError::RestShape(e.to_string()))?;
+        Ok(rest_pattern)
+    }
+
+    /// The evaluation at `x` on the rest shape `rest_pattern` with the Jacobian of the residuals
+    /// by the coordinates, from the sensitivities of the tile's equilibrium to each parameter
+    /// ([`simulate_direction_with_sensitivity`]: the tile with each coordinate moved by
+    /// [`SENSITIVITY_STEP`], on the same rest shape).
+    pub fn evaluate_with_jacobian(
+        &self,
+        rest_pattern: &Pattern,
+        x: &[f64],
+        targets: &[DirectionTargets],
+    ) -> Result<(Evaluation, Vec<Vec<f64>>), YarnFitError> {
+        let (evaluation, tile, rest) = self.evaluate_on(rest_pattern, x, targets)?;
+        let bounds = self.basis.bounds();
+        // Step inwards at the upper bound.
+        let steps: Vec<f64> = x
+            .iter()
+            .zip(&bounds)
+            .map(|(v, (_, hi))| if v + SENSITIVITY_STEP > *hi { -SENSITIVITY_STEP } else { SENSITIVITY_STEP })
+            .collect();
+        let perturbed = steps
+            .iter()
+            .enumerate()
+            .map(|(j, h)| {
+                let mut moved = x.to_vec();
+                moved[j] += h;
+                RveModel::new(&evaluation.rest_pattern, &self.model(&moved).1)
+                    .map_err(|e| YarnFitError::RestShape(e.to_string()))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        // The sensitivities come out per step `h_j`; a backward step flips the sign back.
+        let sensitivities = targets
+            .par_iter()
+            .map(|t| {
+                simulate_direction_with_sensitivity(&tile, &perturbed, SENSITIVITY_STEP, &rest, t)
+                    .map(|(_, mut d)| {
+                        for row in d.compression.iter_mut().chain(d.stress_n_m.iter_mut()) {
+                            for (v, h) in row.iter_mut().zip(&steps) {
+                                *v *= h.signum();
+                            }
+                        }
+                        d
+                    })
+                    .map_err(|e| YarnFitError::Tile(e.to_string()))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((evaluation, residual_jacobian(targets, &sensitivities)))
+    }
+
+    /// The evaluation at `x` on the rest shape `rest_pattern`, with its tile and the tile's
+    /// zero-strain equilibrium.
+    pub fn evaluate_on(
+        &self,
+        rest_pattern: &Pattern,
+        x: &[f64],
+        targets: &[DirectionTargets],
+    ) -> Result<(Evaluation, RveModel, RveState), YarnFitError> {
+        let (params, model) = self.model(x);
         let tile =
-            RveModel::new(&rest_pattern, &model).map_err(|e| YarnFitError::RestShape(e.to_string()))?;
+            RveModel::new(rest_pattern, &model).map_err(|e| YarnFitError::RestShape(e.to_string()))?;
         let zero = MacroStrain::new(0.0, 0.0, 0.0, 0.0, 0.0).expect("zero strain is valid");
         let (report, rest) = solve_at(&tile, &zero, None, &SolveOptions::default());
         if !report.converged {
@@ -231,7 +310,7 @@ impl YarnProblem {
         let curves = simulate(&tile, &rest, targets).map_err(|e| YarnFitError::Tile(e.to_string()))?;
         let residuals = residuals(targets, &curves);
         let cost = residuals.iter().map(|r| r * r).sum();
-        Ok(Evaluation { params, curves, residuals, cost, rest_pattern })
+        Ok((Evaluation { params, curves, residuals, cost, rest_pattern: rest_pattern.clone() }, tile, rest))
     }
 
     /// The point `x` moved into the search box.
@@ -433,6 +512,49 @@ fn local_step(
                 .ok_or_else(|| YarnFitError::Tile("the local step's start has no equilibrium".into()))?;
             let stop = if report.converged { "converged" } else { "iteration limit" };
             (problem.clamped(&report.params), 2.0 * report.cost, stop.to_string())
+        }
+        LocalSolver::GaussNewton => {
+            // Alternate as the thesis does (Sec. 6.5.2): on the rest shape estimated at the
+            // current point, Gauss-Newton / LM with the sensitivity Jacobian (consistent with its
+            // residuals); then re-estimate the rest shape there. `budget` Jacobians in all.
+            let settings = LmSettings {
+                max_iterations: budget.div_ceil(GAUSS_NEWTON_ROUNDS),
+                cost_tolerance: 1e-3,
+                ..LmSettings::default()
+            };
+            let mut current = x.to_vec();
+            let mut stops = Vec::new();
+            for _ in 0..GAUSS_NEWTON_ROUNDS {
+                let Ok(rest_pattern) = problem.rest_shape(&current) else { break };
+                let on_rest = |p: &[f64]| {
+                    let e = problem.evaluate_on(&rest_pattern, &problem.clamped(p), targets).ok();
+                    let n = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    progress(YarnFitEvent::LocalEvaluation(
+                        n,
+                        e.as_ref().map_or(f64::INFINITY, |e| e.0.cost),
+                    ));
+                    e.map(|e| e.0.residuals)
+                };
+                let jacobian = |p: &DVector<f64>, _: &DVector<f64>| {
+                    let n = count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                    let j = problem
+                        .evaluate_with_jacobian(&rest_pattern, &problem.clamped(p.as_slice()), targets)
+                        .ok();
+                    progress(YarnFitEvent::LocalEvaluation(
+                        n,
+                        j.as_ref().map_or(f64::INFINITY, |(e, _)| e.cost),
+                    ));
+                    (j.map(|(_, rows)| DMatrix::from_fn(rows.len(), p.len(), |r, c| rows[r][c])), 0)
+                };
+                let Some(report) = minimize_with_jacobian(on_rest, jacobian, &current, &settings) else {
+                    break;
+                };
+                let stop = if report.converged { "converged" } else { "iteration limit" };
+                stops.push(format!("{stop} at g = {:.4} on its rest shape", 2.0 * report.cost));
+                current = problem.clamped(&report.params);
+            }
+            let cost = evaluate(&current).map_or(f64::INFINITY, |e| e.cost);
+            (current, cost, format!("{} rounds: {}", stops.len(), stops.join(", ")))
         }
         LocalSolver::None => (x.to_vec(), start_cost, "no local step".to_string()),
     };

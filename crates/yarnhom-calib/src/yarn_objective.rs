@@ -15,13 +15,15 @@
 use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use yarnhom_geom::MacroStrain;
 use yarnhom_rve::RveModel;
 use yarnhom_rve::assembly::RveState;
+use yarnhom_rve::homogenize::stress_sensitivities;
 use yarnhom_shell::StvkNeoHookean;
 
 use crate::measure::Direction;
 use crate::uniform::uniaxial;
-use crate::yarn_tile::{TileError, TileSample, solve_uniaxial, zero_orthogonal_stress};
+use crate::yarn_tile::{TileError, TileSample, solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
 
 /// Smallest normalization of compression errors.
 pub const COMPRESSION_FLOOR: f64 = 0.02;
@@ -154,6 +156,15 @@ pub fn simulate_direction(
     rest: &RveState,
     targets: &DirectionTargets,
 ) -> Result<SimulatedCurve, TileError> {
+    Ok(simulate_samples(tile, rest, targets)?.0)
+}
+
+/// [`simulate_direction`], with the solved tile states behind the curve.
+fn simulate_samples(
+    tile: &RveModel,
+    rest: &RveState,
+    targets: &DirectionTargets,
+) -> Result<(SimulatedCurve, Vec<TileSample>), TileError> {
     let (direction, s) = (targets.direction, &targets.stretch);
     let n = s.len();
     let first = zero_orthogonal_stress(tile, direction, s[0], 0.0, Some(rest))?;
@@ -170,8 +181,6 @@ pub fn simulate_direction(
         march.push(sample);
     }
     let (c0, c1) = (march[0].compression, march[n - 1].compression);
-    let interpolated =
-        |i: usize| if n == 1 { c0 } else { c0 + (c1 - c0) * (s[i] - s[0]) / (s[n - 1] - s[0]) };
     let mut curve = SimulatedCurve {
         direction,
         stretch: s.clone(),
@@ -179,18 +188,118 @@ pub fn simulate_direction(
         stress_n_m: Vec::with_capacity(n),
         iterations,
     };
-    for (i, marched) in march.iter().enumerate() {
+    let mut samples = Vec::with_capacity(n);
+    for (i, marched) in march.into_iter().enumerate() {
         let sample = if i == 0 || i + 1 == n {
-            marched.clone()
+            marched
         } else {
-            let sample = solve_uniaxial(tile, direction, s[i], interpolated(i), Some(&marched.state))?;
+            let w = interpolation_weight(s, i);
+            let sample = solve_uniaxial(tile, direction, s[i], c0 + (c1 - c0) * w, Some(&marched.state))?;
             curve.iterations += sample.iterations;
             sample
         };
         curve.compression.push(sample.compression);
         curve.stress_n_m.push(sample.stretch_stress_n_m);
+        samples.push(sample);
     }
-    Ok(curve)
+    Ok((curve, samples))
+}
+
+/// The weight of the last stretch's compression in the interpolated compression at stretch `i`.
+fn interpolation_weight(s: &[f64], i: usize) -> f64 {
+    let n = s.len();
+    if n == 1 { 0.0 } else { (s[i] - s[0]) / (s[n - 1] - s[0]) }
+}
+
+/// Derivatives of a simulated curve by the fitted parameters: `[i][j]` is the derivative of
+/// the `i`-th stretch's value by parameter `j`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveSensitivity {
+    /// `dc_i/dp_j`.
+    pub compression: Vec<Vec<f64>>,
+    /// `dσ_s,i/dp_j` (N/m).
+    pub stress_n_m: Vec<Vec<f64>>,
+}
+
+/// Compression step of the finite difference `∂σ/∂c` at a solved state.
+const COMPRESSION_STEP: f64 = 1e-3;
+
+/// [`simulate_direction`] with the curve's sensitivities to the parameters that turn `tile`
+/// into each of `perturbed` (moved by `step`, same rest shape).
+///
+/// At each solved state the stresses' partial derivatives come from the linearized equilibrium
+/// ([`yarnhom_rve::homogenize::stress_sensitivities`]), and `∂σ/∂c` from one warm-started
+/// solve at `c + 10⁻³`. The end compressions keep `σ_c = 0`, so
+/// `dc/dp = -(∂σ_c/∂p) / (∂σ_c/∂c)` there; in between `c` is interpolated, and so is `dc/dp`;
+/// then `dσ_s/dp = ∂σ_s/∂p + (∂σ_s/∂c) dc/dp`.
+pub fn simulate_direction_with_sensitivity(
+    tile: &RveModel,
+    perturbed: &[RveModel],
+    step: f64,
+    rest: &RveState,
+    targets: &DirectionTargets,
+) -> Result<(SimulatedCurve, CurveSensitivity), TileError> {
+    let (curve, samples) = simulate_samples(tile, rest, targets)?;
+    let direction = targets.direction;
+    let s = &targets.stretch;
+    // Per sample: (∂σ_s/∂p, ∂σ_c/∂p) and (∂σ_s/∂c, ∂σ_c/∂c).
+    let partials = samples
+        .par_iter()
+        .map(|sample| {
+            let map = uniaxial_strain(direction, sample.stretch, sample.compression);
+            let [sx, sa, sy] = map.strain;
+            let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0)
+                .map_err(|_| TileError::BadStrain(sample.compression))?;
+            let no_equilibrium = || TileError::NoEquilibrium {
+                direction,
+                stretch: sample.stretch,
+                compression: sample.compression,
+            };
+            let d_sigma = stress_sensitivities(tile, perturbed, step, &strain, &sample.state)
+                .ok_or_else(no_equilibrium)?;
+            let along = |sigma: &[f64; 5], d: [f64; 3]| (0..3).map(|k| sigma[k] * d[k]).sum::<f64>();
+            let by_p: Vec<(f64, f64)> =
+                d_sigma.iter().map(|d| (along(d, map.d_stretch), along(d, map.d_compression))).collect();
+            let h = COMPRESSION_STEP;
+            let moved =
+                solve_uniaxial(tile, direction, sample.stretch, sample.compression + h, Some(&sample.state))?;
+            let by_c = (
+                (moved.stretch_stress_n_m - sample.stretch_stress_n_m) / h,
+                (moved.compression_stress_n_m - sample.compression_stress_n_m) / h,
+            );
+            Ok((by_p, by_c))
+        })
+        .collect::<Result<Vec<_>, TileError>>()?;
+    let n = s.len();
+    let parameters = perturbed.len();
+    let end_compression = |i: usize| -> Vec<f64> {
+        let (by_p, (_, dsc_dc)) = &partials[i];
+        by_p.iter().map(|(_, dsc_dp)| -dsc_dp / dsc_dc).collect()
+    };
+    let (first, last) = (end_compression(0), end_compression(n - 1));
+    let mut sensitivity =
+        CurveSensitivity { compression: Vec::with_capacity(n), stress_n_m: Vec::with_capacity(n) };
+    for (i, (by_p, (dss_dc, _))) in partials.iter().enumerate() {
+        let w = interpolation_weight(s, i);
+        let dc: Vec<f64> = (0..parameters).map(|j| first[j] + (last[j] - first[j]) * w).collect();
+        sensitivity.stress_n_m.push((0..parameters).map(|j| by_p[j].0 + dss_dc * dc[j]).collect());
+        sensitivity.compression.push(dc);
+    }
+    Ok((curve, sensitivity))
+}
+
+/// The Jacobian of [`residuals`] from the curves' sensitivities (rows in residual order).
+pub fn residual_jacobian(targets: &[DirectionTargets], sensitivities: &[CurveSensitivity]) -> Vec<Vec<f64>> {
+    let mut rows = Vec::new();
+    for (t, d) in targets.iter().zip(sensitivities) {
+        for i in 0..t.stretch.len() {
+            let (ws, wc) = t.weights(i);
+            let scale_s = ws / (1.0 + t.stretch[i]) / t.comfort_stress_n_m;
+            rows.push(d.stress_n_m[i].iter().map(|x| scale_s * x).collect());
+            rows.push(d.compression[i].iter().map(|x| wc * x / t.compression_scale()).collect());
+        }
+    }
+    rows
 }
 
 /// [`simulate_direction`] for every direction, in parallel.

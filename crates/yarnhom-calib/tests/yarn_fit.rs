@@ -10,9 +10,9 @@ use yarnhom_calib::yarn_fit::{
 };
 use yarnhom_calib::yarn_objective::{COMFORT_FORCE_N, residuals};
 use yarnhom_calib::yarn_params::YarnBasis;
-use yarnhom_calib::yarn_tile::{solve_uniaxial, zero_orthogonal_stress};
+use yarnhom_calib::yarn_tile::{solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::solve_at;
+use yarnhom_rve::homogenize::{solve_at, stress_sensitivities};
 use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, relax};
 
 fn stockinette() -> Pattern {
@@ -28,8 +28,8 @@ fn basis(pattern: &Pattern) -> YarnBasis {
     YarnBasis::of_pattern(pattern, Some(200.0), 1180.0)
 }
 
-/// The rest-estimated tile of the hidden model and its zero-strain equilibrium.
-fn truth_tile() -> (RveModel, yarnhom_rve::assembly::RveState) {
+/// The rest-estimated pattern and tile of the hidden model and its zero-strain equilibrium.
+fn truth_tile() -> (Pattern, RveModel, yarnhom_rve::assembly::RveState) {
     let pattern = stockinette();
     let basis = basis(&pattern);
     let model = basis.params(&TRUTH).model("truth", &basis);
@@ -43,12 +43,12 @@ fn truth_tile() -> (RveModel, yarnhom_rve::assembly::RveState) {
     let zero = MacroStrain::new(0.0, 0.0, 0.0, 0.0, 0.0).expect("valid");
     let (report, state) = solve_at(&tile, &zero, None, &SolveOptions::default());
     assert!(report.converged);
-    (tile, state)
+    (rest, tile, state)
 }
 
 #[test]
 fn the_stretch_stress_is_the_energy_slope_and_the_compression_leaves_no_orthogonal_stress() {
-    let (tile, rest) = truth_tile();
+    let (_, tile, rest) = truth_tile();
     for direction in [Direction::Weft, Direction::Bias, Direction::Warp] {
         // Past the slack range of the generated stockinette (its yarns go taut near 30%).
         let s = 0.45;
@@ -105,26 +105,84 @@ fn the_hidden_model_has_no_residual_and_the_local_steps_move_towards_it() {
     // Start with the yarn 4x softer at low stretch and 3x softer in bending.
     let start = [TRUTH[0] - 0.6, TRUTH[1], TRUTH[2] - 0.5, TRUTH[3], TRUTH[4]];
     let mut outcomes = Vec::new();
-    for local in [LocalSolver::Cobyla, LocalSolver::LevenbergMarquardt] {
+    for local in [LocalSolver::GaussNewton, LocalSolver::Cobyla, LocalSolver::LevenbergMarquardt] {
         let settings = YarnFitSettings {
             swarm: SwarmSettings::default(),
             local_targets: 5,
             local,
-            local_budget: if local == LocalSolver::Cobyla { 40 } else { 4 },
+            local_budget: match local {
+                LocalSolver::Cobyla => 40,
+                LocalSolver::GaussNewton => 8,
+                _ => 4,
+            },
             ..YarnFitSettings::default()
         };
+        let started = std::time::Instant::now();
         let fitted = fit_yarn(&problem, "hidden", &settings, Some(&start), &|_| {}).expect("fits");
         let report = fitted.fit.local.clone().expect("a local step ran");
         let worst = fitted.fit.errors.iter().map(|e| e.comfort_stress).fold(0.0, f64::max);
+        eprintln!("{local:?}: {:.1} s, {report:?}", started.elapsed().as_secs_f64());
         outcomes.push((local, report, worst));
     }
-    // The objective is not smooth (every evaluation re-estimates the rest shape), so neither
-    // optimizer reaches zero; both must remove most of the misfit.
+    // The objective is not smooth (every evaluation re-estimates the rest shape), so no
+    // optimizer reaches zero; COBYLA and LM (whose finite differences go through the rest-shape
+    // estimation) must remove most of the misfit. Gauss-Newton's sensitivity Jacobian holds the
+    // rest shape, and each re-estimation moves the optimum it converged to: it must still
+    // halve the misfit (measured: 0.347 -> 0.165 in 8 Jacobians, 31 evaluations; COBYLA 0.115
+    // in 39; LM 0.061 in 43).
     for (local, report, worst) in &outcomes {
         eprintln!("{local:?}: {report:?}, worst comfort stress error {worst:.4}");
+        let bound = if *local == LocalSolver::GaussNewton { 0.6 } else { 0.35 };
         assert!(
-            report.cost < 0.35 * report.start_cost,
+            report.cost < bound * report.start_cost,
             "{local:?}: {report:?} (worst comfort error {worst})"
+        );
+    }
+}
+
+#[test]
+fn stress_sensitivities_of_the_linearized_equilibrium_match_finite_differences_of_solves() {
+    // The taut stockinette (45% stretch) at its compression of zero orthogonal stress, with
+    // each yarn-model coordinate moved: dσ/dp by the linearized equilibrium against central
+    // differences of warm-started re-solves at the same strain.
+    let basis = basis(&stockinette());
+    let (rest_pattern, tile, rest) = truth_tile();
+    // Same rest shape as the truth tile: only the material law and the contact change.
+    let tile_at =
+        |x: &[f64]| RveModel::new(&rest_pattern, &basis.params(x).model("x", &basis)).expect("tile");
+    let direction = Direction::Weft;
+    let zero = zero_orthogonal_stress(&tile, direction, 0.45, 0.0, Some(&rest)).expect("found");
+    let map = uniaxial_strain(direction, zero.stretch, zero.compression);
+    let [sx, sa, sy] = map.strain;
+    let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0).expect("valid");
+    let step = 1e-4;
+    let perturbed: Vec<RveModel> = (0..TRUTH.len())
+        .map(|j| {
+            let mut x = TRUTH;
+            x[j] += step;
+            tile_at(&x)
+        })
+        .collect();
+    let sensitivities = stress_sensitivities(&tile, &perturbed, step, &strain, &zero.state).expect("factors");
+    let along = |sigma: &[f64; 5], d: [f64; 3]| (0..3).map(|k| sigma[k] * d[k]).sum::<f64>();
+    let h = 1e-2;
+    for (j, d) in sensitivities.iter().enumerate() {
+        let stresses = |sign: f64| {
+            let mut x = TRUTH;
+            x[j] += sign * h;
+            let sample =
+                solve_uniaxial(&tile_at(&x), direction, zero.stretch, zero.compression, Some(&zero.state))
+                    .expect("solves");
+            (sample.stretch_stress_n_m, sample.compression_stress_n_m)
+        };
+        let (plus, minus) = (stresses(1.0), stresses(-1.0));
+        let fd = ((plus.0 - minus.0) / (2.0 * h), (plus.1 - minus.1) / (2.0 * h));
+        let mine = (along(d, map.d_stretch), along(d, map.d_compression));
+        eprintln!("coordinate {j}: dσ_s {:.4e} vs {:.4e}, dσ_c {:.4e} vs {:.4e}", mine.0, fd.0, mine.1, fd.1);
+        let scale = fd.0.abs().max(fd.1.abs()).max(1e-3 * zero.stretch_stress_n_m.abs());
+        assert!(
+            (mine.0 - fd.0).abs() < 0.05 * scale && (mine.1 - fd.1).abs() < 0.05 * scale,
+            "coordinate {j}: {mine:?} vs finite differences {fd:?}"
         );
     }
 }

@@ -23,6 +23,9 @@ pub enum LocalArg {
     Cobyla,
     /// Levenberg-Marquardt on the residuals of (6.11), forward-difference Jacobian.
     Lm,
+    /// Gauss-Newton / Levenberg-Marquardt with the Jacobian from the parameter sensitivities of
+    /// the tile's equilibrium (one evaluation per Jacobian instead of one per parameter).
+    GaussNewton,
     /// No local step.
     None,
 }
@@ -54,7 +57,7 @@ pub struct YarnArgs {
     /// The local optimizer.
     #[arg(long, value_enum, default_value = "cobyla")]
     pub local: LocalArg,
-    /// Evaluations of the local step at most (COBYLA) or Jacobians (LM).
+    /// Evaluations of the local step at most (COBYLA) or Jacobians (LM, Gauss-Newton).
     #[arg(long, default_value_t = 60)]
     pub budget: u32,
     /// Seed of the swarm.
@@ -130,6 +133,7 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
             (Some(_), _) | (None, LocalArg::None) => LocalSolver::None,
             (None, LocalArg::Cobyla) => LocalSolver::Cobyla,
             (None, LocalArg::Lm) => LocalSolver::LevenbergMarquardt,
+            (None, LocalArg::GaussNewton) => LocalSolver::GaussNewton,
         },
         local_budget: args.budget as usize,
         rest: RestShapeSettings { max_length_change: 0.2, max_resets: args.max_resets as usize },

@@ -1,12 +1,15 @@
 //! Homogenized energy density and stress of a tile at one macro strain (3.22-3.23).
 
 use nalgebra::Vector3;
+use rayon::prelude::*;
 use yarnhom_geom::{MacroStrain, StrainError};
 
 use crate::assembly::{RveState, Want, assemble};
 use crate::model::RveModel;
 use crate::placement::Placement;
-use crate::solve::{Iterate, SolveOptions, SolveReport, constraints, multipliers, solve_observed};
+use crate::solve::{
+    Iterate, SolveOptions, SolveReport, constraints, equilibrium_response, multipliers, solve_observed,
+};
 
 /// Central-difference steps of the solve-based stress: strain (dimensionless) and curvature (in
 /// units of one over the tile's mean period, so that the step bends the tile by a similar amount).
@@ -84,6 +87,66 @@ pub fn stress_at_equilibrium(model: &RveModel, strain: &MacroStrain, state: &Rve
     }
     stress
 }
+
+/// Sensitivities of the homogenized stress (3.23c) at the equilibrium `state` of `strain` to
+/// the parameters of the energy: `perturbed[j]` is `model` with parameter `j` moved by `step`
+/// (same tile and rest shape, another material law or contact). Returns `dσ/dp_j` for each.
+///
+/// The equilibrium moves with the parameter: the prediction `dg/dp_j = δ_j` comes from the
+/// linearized equilibrium `H δ_j = -∂∇E/∂p_j` under the constraints ([`equilibrium_response`],
+/// one factorization for every parameter, `∂∇E/∂p_j` by a forward difference of the gradient
+/// at fixed `g`); a tight Newton correction from `g + step δ_j` then removes what the rods'
+/// lagged-reference-twist Hessian misses (for stretch and contact parameters it converges at
+/// once, for bending in a few iterations), and
+/// `dσ/dp_j = (σ(p + step e_j, corrected) - σ(p, g)) / step` ([`stress_at_equilibrium`]).
+/// The base state is first settled to the same tight tolerance, since a small step's stress
+/// difference resolves the equilibrium far below the fits' tolerance (where round-off keeps a
+/// solve from it, its last, lowest-energy iterate is used). `None` if the Hessian cannot be
+/// factored.
+pub fn stress_sensitivities(
+    model: &RveModel,
+    perturbed: &[RveModel],
+    step: f64,
+    strain: &MacroStrain,
+    state: &RveState,
+) -> Option<Vec<[f64; 5]>> {
+    let here = placement(model, strain);
+    // Stress differences over a small step resolve the equilibrium far below the fits'
+    // tolerance: settle the base and each corrected prediction tightly.
+    let tight = SolveOptions {
+        tolerance: SENSITIVITY_TOLERANCE,
+        max_iterations: 100,
+        ..SolveOptions::warm_started()
+    };
+    // Where round-off keeps a solve from the tight tolerance, its last iterate is used: the
+    // line search only accepts iterates of lower energy, so it is no worse than its start.
+    let mut base = state.clone();
+    solve_observed(model, &here, &mut base, &tight, &mut |_| {});
+    let gradient = |m: &RveModel| assemble(m, &here, &base, &base.g, Want::EnergyGradient).gradient;
+    let at_base = gradient(model);
+    let forces: Vec<_> = perturbed.iter().map(|m| (gradient(m) - &at_base) / step).collect();
+    let responses = equilibrium_response(model, &here, &base, &forces)?;
+    let sigma = stress_at_equilibrium(model, strain, &base);
+    let sensitivities = perturbed
+        .par_iter()
+        .zip(responses)
+        .map(|(m, delta)| {
+            let mut moved = base.clone();
+            moved.g += delta * step;
+            moved.update_frames(m, &here);
+            // Correct the prediction: the rods' Hessian lags the reference twist (Bergou et
+            // al. 2010), so the linear response is exact for stretch and contact but only
+            // close for bending and twist.
+            solve_observed(m, &here, &mut moved, &tight, &mut |_| {});
+            let moved_sigma = stress_at_equilibrium(m, strain, &moved);
+            std::array::from_fn(|k| (moved_sigma[k] - sigma[k]) / step)
+        })
+        .collect();
+    Some(sensitivities)
+}
+
+/// Convergence tolerance (A.33) of the solves inside [`stress_sensitivities`].
+const SENSITIVITY_TOLERANCE: f64 = 1e-9;
 
 /// One over the tile's mean period (1/m): the curvature that bends the tile by about a radian,
 /// the unit of curvature steps.

@@ -294,6 +294,51 @@ fn force_floor(model: &RveModel) -> f64 {
     model.material_law.stretch.density(1e-3).1 * (model.vertices as f64).sqrt()
 }
 
+/// Relative diagonal shift of the Hessian in [`equilibrium_response`]: enough to factor a
+/// Hessian whose only soft directions are the ones the constraints remove, too little to bias
+/// the response (a millionth of its largest diagonal).
+const RESPONSE_SHIFT: f64 = 1e-6;
+
+/// The linear response of the equilibrium `state` under `placement` to perturbations of the
+/// forces: for each `b` in `forces` the `δ` of `H δ + Cᵀ μ = -b`, `C δ = 0` (the linearized
+/// (3.24) under the constraints, `H` the energy Hessian the Newton solver assembles), all on
+/// one factorization. With `b = ∂∇E/∂p` this is `dg/dp`, the equilibrium's sensitivity to a
+/// parameter `p` of the energy. `None` if the Hessian cannot be factored.
+pub fn equilibrium_response(
+    model: &RveModel,
+    placement: &Placement,
+    state: &RveState,
+    forces: &[DVector<f64>],
+) -> Option<Vec<DVector<f64>>> {
+    let n = model.dof_count();
+    let c = constraints(model, placement);
+    let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * model.radius_m });
+    let c_scaled = &c * DMatrix::from_diagonal(&scale);
+    let current = assemble(model, placement, state, &state.g, Want::Derivatives);
+    let scaled_hessian: Vec<(usize, usize, f64)> =
+        current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
+    let largest =
+        scaled_hessian.iter().filter(|(i, j, _)| i == j).map(|(_, _, v)| v.abs()).fold(0.0, f64::max);
+    let mut solver = SpdSolver::default();
+    let mut shift = RESPONSE_SHIFT * largest.max(1e-300);
+    while solver.factor(n, &scaled_hessian, shift).is_err() {
+        shift *= 10.0;
+        if shift > largest {
+            return None;
+        }
+    }
+    let feasible = DVector::zeros(c.nrows());
+    Some(
+        forces
+            .iter()
+            .map(|b| {
+                constrained_step(&solver, &c_scaled, &b.component_mul(&scale), &feasible)
+                    .component_mul(&scale)
+            })
+            .collect(),
+    )
+}
+
 /// The step of the regularized, constrained Newton system by the range-space method:
 /// `K w = -∇`, `K Y = Cᵀ`, `λ = (C Y)⁻¹ (C w + residual)`, step `w - Y λ` (so `C step = -residual`).
 fn constrained_step(
