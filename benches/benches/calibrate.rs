@@ -18,8 +18,9 @@ use yarnhom_calib::measure::{Direction, Face};
 use yarnhom_calib::pear_loop::PearLoopTest;
 use yarnhom_calib::stitch_by_stitch::import_fabric;
 use yarnhom_calib::swatch::SwatchTest;
+use yarnhom_calib::synth::{BendingPlan, HiddenEffect, ground_truth};
 use yarnhom_calib::targets::{TargetPlan, targets};
-use yarnhom_shell::{HingeBending, StvkNeoHookean};
+use yarnhom_shell::StvkNeoHookean;
 
 fn bench_objective(c: &mut Criterion) {
     let data = format!("{}/../../shared/data/stitch-by-stitch-acrylic", env!("CARGO_MANIFEST_DIR"));
@@ -56,19 +57,13 @@ fn bench_objective(c: &mut Criterion) {
 }
 
 fn bench_bending(c: &mut Criterion) {
-    let membrane = StvkNeoHookean {
-        k_xx: 60.0,
-        k_xy: 6.0,
-        k_yy: 25.0,
-        k_ss: 10.0,
-        k_n1: 0.0,
-        k_n2: 0.0,
-        stiffening: None,
-    };
-    let bending = HingeBending::isotropic(1e-6);
-    let distances: Vec<f64> = (0..7).map(|k| 0.003 + 0.031 * k as f64 / 6.0).collect();
+    // The synthetic sets' base truth and bending tests.
+    let truth = ground_truth(HiddenEffect::None, 0.0);
+    let (membrane, bending) = (truth.membrane, truth.bending);
+    let plan = BendingPlan::default();
+    let distances = plan.clamp_distances_m;
     let overhangs: Vec<(Face, f64)> =
-        Face::ALL.into_iter().flat_map(|f| (0..7).map(move |k| (f, 0.008 + 0.004 * k as f64))).collect();
+        Face::ALL.into_iter().flat_map(|f| plan.overhangs_m.iter().map(move |o| (f, *o))).collect();
     let pear = PearLoopTest::new(Direction::Weft, 0.1, 0.25, BENDING_SPACING_M);
     let cantilever = CantileverTest {
         direction: Direction::Weft,
