@@ -300,8 +300,7 @@ impl YarnProblem {
         targets: &[DirectionTargets],
     ) -> Result<(Evaluation, RveModel, RveState), YarnFitError> {
         let (params, model) = self.model(x);
-        let tile =
-            RveModel::new(rest_pattern, &model).map_err(|e| YarnFitError::RestShape(e.to_string()))?;
+        let tile = RveModel::new(rest_pattern, &model).map_err(|e| YarnFitError::RestShape(e.to_string()))?;
         let zero = MacroStrain::new(0.0, 0.0, 0.0, 0.0, 0.0).expect("zero strain is valid");
         let (report, rest) = solve_at(&tile, &zero, None, &SolveOptions::default());
         if !report.converged {
