@@ -15,7 +15,6 @@
 use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_geom::MacroStrain;
 use yarnhom_rve::RveModel;
 use yarnhom_rve::assembly::RveState;
 use yarnhom_rve::homogenize::stress_sensitivities;
@@ -247,9 +246,7 @@ pub fn simulate_direction_with_sensitivity(
         .par_iter()
         .map(|sample| {
             let map = uniaxial_strain(direction, sample.stretch, sample.compression);
-            let [sx, sa, sy] = map.strain;
-            let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0)
-                .map_err(|_| TileError::BadStrain(sample.compression))?;
+            let strain = map.macro_strain(sample.compression)?;
             let no_equilibrium = || TileError::NoEquilibrium {
                 direction,
                 stretch: sample.stretch,
@@ -257,9 +254,7 @@ pub fn simulate_direction_with_sensitivity(
             };
             let d_sigma = stress_sensitivities(tile, perturbed, step, &strain, &sample.state)
                 .ok_or_else(no_equilibrium)?;
-            let along = |sigma: &[f64; 5], d: [f64; 3]| (0..3).map(|k| sigma[k] * d[k]).sum::<f64>();
-            let by_p: Vec<(f64, f64)> =
-                d_sigma.iter().map(|d| (along(d, map.d_stretch), along(d, map.d_compression))).collect();
+            let by_p: Vec<(f64, f64)> = d_sigma.iter().map(|d| map.stretch_and_compression(d)).collect();
             let h = COMPRESSION_STEP;
             let moved =
                 solve_uniaxial(tile, direction, sample.stretch, sample.compression + h, Some(&sample.state))?;

@@ -28,6 +28,21 @@ pub struct UniaxialStrain {
     pub d_compression: [f64; 3],
 }
 
+impl UniaxialStrain {
+    /// The tile's macro strain (no bending); `compression` names a strain that is not valid.
+    pub fn macro_strain(&self, compression: f64) -> Result<MacroStrain, TileError> {
+        let [sx, sa, sy] = self.strain;
+        MacroStrain::new(sx, sa, sy, 0.0, 0.0).map_err(|_| TileError::BadStrain(compression))
+    }
+
+    /// `(σ_s, σ_c) = (∂Ψ/∂s, ∂Ψ/∂c)` from the homogenized stress `∂Ψ/∂(sx, sa, sy, kx, ky)`
+    /// (or from its derivative by a parameter), by the chain rule through the strain map.
+    pub fn stretch_and_compression(&self, stress: &[f64; 5]) -> (f64, f64) {
+        let along = |d: [f64; 3]| (0..3).map(|k| stress[k] * d[k]).sum::<f64>();
+        (along(self.d_stretch), along(self.d_compression))
+    }
+}
+
 /// (4.1) of `I = Fᵀ F`, `F = (1 + s) u uᵀ + (1 - c) v vᵀ`, with its derivatives (closed form).
 pub fn uniaxial_strain(direction: Direction, stretch: f64, compression: f64) -> UniaxialStrain {
     let u = pull_axis(direction);
@@ -111,8 +126,7 @@ pub fn solve_uniaxial(
     start: Option<&RveState>,
 ) -> Result<TileSample, TileError> {
     let map = uniaxial_strain(direction, stretch, compression);
-    let [sx, sa, sy] = map.strain;
-    let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0).map_err(|_| TileError::BadStrain(compression))?;
+    let strain = map.macro_strain(compression)?;
     let options = if start.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
     let (mut report, mut state) = solve_at(tile, &strain, start, &options);
     if !report.converged && start.is_some() {
@@ -123,14 +137,14 @@ pub fn solve_uniaxial(
     if !report.converged {
         return Err(TileError::NoEquilibrium { direction, stretch, compression });
     }
-    let sigma = stress_at_equilibrium(tile, &strain, &state);
-    let along = |d: [f64; 3]| (0..3).map(|k| sigma[k] * d[k]).sum::<f64>();
+    let (stretch_stress_n_m, compression_stress_n_m) =
+        map.stretch_and_compression(&stress_at_equilibrium(tile, &strain, &state));
     Ok(TileSample {
         stretch,
         compression,
         energy_j_m2: report.energy_density_j_m2,
-        stretch_stress_n_m: along(map.d_stretch),
-        compression_stress_n_m: along(map.d_compression),
+        stretch_stress_n_m,
+        compression_stress_n_m,
         state,
         iterations: report.iterations,
     })

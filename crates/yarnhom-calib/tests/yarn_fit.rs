@@ -153,8 +153,7 @@ fn stress_sensitivities_of_the_linearized_equilibrium_match_finite_differences_o
     let direction = Direction::Weft;
     let zero = zero_orthogonal_stress(&tile, direction, 0.45, 0.0, Some(&rest)).expect("found");
     let map = uniaxial_strain(direction, zero.stretch, zero.compression);
-    let [sx, sa, sy] = map.strain;
-    let strain = MacroStrain::new(sx, sa, sy, 0.0, 0.0).expect("valid");
+    let strain = map.macro_strain(zero.compression).expect("valid");
     let step = 1e-4;
     let perturbed: Vec<RveModel> = (0..TRUTH.len())
         .map(|j| {
@@ -164,7 +163,6 @@ fn stress_sensitivities_of_the_linearized_equilibrium_match_finite_differences_o
         })
         .collect();
     let sensitivities = stress_sensitivities(&tile, &perturbed, step, &strain, &zero.state).expect("factors");
-    let along = |sigma: &[f64; 5], d: [f64; 3]| (0..3).map(|k| sigma[k] * d[k]).sum::<f64>();
     let h = 1e-2;
     for (j, d) in sensitivities.iter().enumerate() {
         let stresses = |sign: f64| {
@@ -177,7 +175,7 @@ fn stress_sensitivities_of_the_linearized_equilibrium_match_finite_differences_o
         };
         let (plus, minus) = (stresses(1.0), stresses(-1.0));
         let fd = ((plus.0 - minus.0) / (2.0 * h), (plus.1 - minus.1) / (2.0 * h));
-        let mine = (along(d, map.d_stretch), along(d, map.d_compression));
+        let mine = map.stretch_and_compression(d);
         eprintln!("coordinate {j}: dσ_s {:.4e} vs {:.4e}, dσ_c {:.4e} vs {:.4e}", mine.0, fd.0, mine.1, fd.1);
         let scale = fd.0.abs().max(fd.1.abs()).max(1e-3 * zero.stretch_stress_n_m.abs());
         assert!(
