@@ -9,6 +9,7 @@ use yarnhom_rod::{
     BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
 };
 
+use crate::broadphase::{Aabb, EdgePair};
 use crate::model::{BendElement, RveModel, material_edge};
 use crate::placement::{Instance, Placement};
 
@@ -26,7 +27,9 @@ pub struct Assembled {
 /// What to assemble.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Want {
-    /// Energy and gradient (line searches, stress).
+    /// Energy only (line searches, stress); the gradient is left zero.
+    Energy,
+    /// Energy and gradient.
     EnergyGradient,
     /// Energy, gradient and Hessian.
     Derivatives,
@@ -220,16 +223,35 @@ pub fn assemble(
     g: &DVector<f64>,
     want: Want,
 ) -> Assembled {
+    let candidates = ContactCandidates::new(model, placement, g, 0.0);
+    assemble_with(model, placement, state, g, want, &candidates)
+}
+
+/// [`assemble`] with the contact pairs taken from `candidates`, which must cover `g`
+/// ([`ContactCandidates::cover`]): the same result, without a broad phase of its own.
+pub fn assemble_with(
+    model: &RveModel,
+    placement: &Placement,
+    state: &RveState,
+    g: &DVector<f64>,
+    want: Want,
+    candidates: &ContactCandidates,
+) -> Assembled {
     let mut out =
         Assembled { energy_j: 0.0, gradient: DVector::zeros(model.dof_count()), hessian: Vec::new() };
     let derivatives = want == Want::Derivatives;
+    if derivatives {
+        out.hessian.reserve(hessian_capacity(model, candidates.pairs.len()));
+    }
     let position = |i: Instance| position_of(model, placement, g, i);
     for s in &model.stretch {
         let (e, grad, hess) =
             stretch_energy(&model.material_law.stretch, s.rest_length_m, &position(s.from), &position(s.to));
         out.energy_j += e;
-        let h = derivatives.then_some(hess.as_slice());
-        Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h);
+        if want != Want::Energy {
+            let h = derivatives.then_some(hess.as_slice());
+            Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h);
+        }
     }
     for (k, b) in model.bends.iter().enumerate() {
         let reference = bend_reference(placement, state, b, k);
@@ -248,33 +270,97 @@ pub fn assemble(
             out.energy_j += b.element.energy(&reference, &q);
         }
     }
-    add_contacts(model, placement, g, derivatives, &mut out);
+    add_contacts(model, placement, g, want, candidates, &mut out);
     out
 }
 
+/// Hessian triplets of the stretch and bend elements and of `pairs` contacts at most.
+fn hessian_capacity(model: &RveModel, pairs: usize) -> usize {
+    // Stretch: 2 vertices; bend: 3 vertices and 2 twists; contact: 4 vertices.
+    let dense = |dofs: usize| dofs * dofs;
+    model.stretch.len() * dense(6) + model.bends.len() * dense(11) + pairs * dense(12)
+}
+
+/// The edge pairs that may come within contact reach while no vertex moves more than an
+/// allowance from the DOFs they were found at (a Verlet list): the broad phase
+/// ([`crate::broadphase`]) on the edges' boxes grown by half the reach plus the allowance. Under
+/// one placement a vertex instance moves by `|R Δg_v| = |Δg_v|`, so each edge's box at DOFs
+/// within the allowance lies in its grown box, and every pair within reach there is a candidate.
+#[derive(Debug, Clone)]
+pub struct ContactCandidates {
+    /// DOFs the pairs were found at.
+    g: DVector<f64>,
+    /// Largest vertex move they allow (m).
+    allowance: f64,
+    /// The candidate pairs, sorted.
+    pairs: Vec<EdgePair>,
+    /// The image edges `(image, edge)` of the pairs, each once: `pairs[k]`'s is
+    /// `image_edges[image_edge[k]]`.
+    image_edges: Vec<(usize, usize)>,
+    image_edge: Vec<usize>,
+}
+
+impl ContactCandidates {
+    /// The candidates at DOFs `g` under `placement` for vertex moves up to `allowance` (m).
+    pub fn new(model: &RveModel, placement: &Placement, g: &DVector<f64>, allowance: f64) -> Self {
+        // The relative 1e-9 keeps pairs whose quadrature points round to just within reach.
+        let margin = 0.5 * model.contact.reach_m() * (1.0 + 1e-9) + allowance;
+        let boxes: Vec<Vec<Aabb>> = image_segments(model, placement, g)
+            .iter()
+            .map(|e| e.iter().map(|(p, q)| Aabb::around_segment(p, q, margin)).collect())
+            .collect();
+        let pairs = crate::broadphase::edge_pairs(model, &boxes);
+        let mut slot = vec![usize::MAX; model.images.len() * model.stretch.len()];
+        let mut image_edges = Vec::new();
+        let image_edge = pairs
+            .iter()
+            .map(|p| {
+                let k = &mut slot[p.image * model.stretch.len() + p.b];
+                if *k == usize::MAX {
+                    *k = image_edges.len();
+                    image_edges.push((p.image, p.b));
+                }
+                *k
+            })
+            .collect();
+        ContactCandidates { g: g.clone(), allowance, pairs, image_edges, image_edge }
+    }
+
+    /// Whether the candidates hold at DOFs `g`: no vertex moved more than the allowance.
+    pub fn cover(&self, model: &RveModel, g: &DVector<f64>) -> bool {
+        (0..model.vertices as u32).all(|v| {
+            let k = model.position_dof(v);
+            let moved = Vector3::new(g[k] - self.g[k], g[k + 1] - self.g[k + 1], g[k + 2] - self.g[k + 2]);
+            moved.norm() <= self.allowance
+        })
+    }
+}
+
 /// Contact (Sec. 3.3) between every edge of the tile and every edge of the tile images within
-/// reach ([`RveModel::images`]), each physical pair once, neighbours along a yarn excluded. The
-/// candidates come from the broad phase ([`crate::broadphase`]) on the edges' boxes grown by half
-/// the reach, which overlap for every pair within reach (the contact energy vanishes beyond it);
-/// they are summed in sorted order, so the result is reproducible.
+/// reach ([`RveModel::images`]), each physical pair once, neighbours along a yarn excluded: the
+/// pairs of `candidates` whose segments come within reach, summed in sorted order, so the
+/// result is reproducible (and the same for every covering set of candidates).
 fn add_contacts(
     model: &RveModel,
     placement: &Placement,
     g: &DVector<f64>,
-    derivatives: bool,
+    want: Want,
+    candidates: &ContactCandidates,
     out: &mut Assembled,
 ) {
-    use crate::broadphase::{Aabb, EdgePair};
     let reach = model.contact.reach_m();
-    let ends = image_segments(model, placement, g);
-    // The relative 1e-9 keeps pairs whose quadrature points round to just within reach.
-    let margin = 0.5 * reach * (1.0 + 1e-9);
-    let boxes: Vec<Vec<Aabb>> =
-        ends.iter().map(|e| e.iter().map(|(p, q)| Aabb::around_segment(p, q, margin)).collect()).collect();
-    let tile = &ends[crate::broadphase::tile_image(model)];
-    for EdgePair { a, image, b } in crate::broadphase::edge_pairs(model, &boxes) {
+    let segment = |i: Instance, j: Instance, o: [i32; 2]| {
+        (position_of(model, placement, g, shifted(i, o)), position_of(model, placement, g, shifted(j, o)))
+    };
+    let tile: Vec<_> = model.stretch.iter().map(|s| segment(s.from, s.to, [0, 0])).collect();
+    let images: Vec<_> = candidates
+        .image_edges
+        .iter()
+        .map(|&(image, b)| segment(model.stretch[b].from, model.stretch[b].to, model.images[image]))
+        .collect();
+    for (&EdgePair { a, image, b }, &k) in candidates.pairs.iter().zip(&candidates.image_edge) {
         let (a0, a1) = tile[a];
-        let (b0, b1) = ends[image][b];
+        let (b0, b1) = images[k];
         if lower_bound(&a0, &a1, &b0, &b1) >= reach {
             continue;
         }
@@ -288,7 +374,10 @@ fn add_contacts(
             continue;
         }
         out.energy_j += e;
-        let h = derivatives.then_some(hess.as_slice());
+        if want == Want::Energy {
+            continue;
+        }
+        let h = (want == Want::Derivatives).then_some(hess.as_slice());
         let (sa, sb, o) = (model.stretch[a], model.stretch[b], model.images[image]);
         let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
         Scatter { model, placement, out: &mut *out }.add(&instances, &[], grad.as_slice(), h);

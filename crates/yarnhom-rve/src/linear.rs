@@ -7,7 +7,7 @@
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
-use faer::sparse::{Pair, SparseColMatRef, SymbolicSparseColMat};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{MatMut, Side};
 
 /// The matrix was not positive definite (or the factorization failed otherwise).
@@ -27,10 +27,7 @@ impl Analysis {
     /// Analyse the `n x n` pattern of the lower-triangle positions `entries` (any order, repeats
     /// allowed) and the diagonal.
     fn new(n: usize, entries: impl Iterator<Item = (usize, usize)>) -> Result<Self, NotPositiveDefinite> {
-        let pairs: Vec<Pair<usize, usize>> =
-            entries.chain((0..n).map(|i| (i, i))).map(|(row, col)| Pair { row, col }).collect();
-        let (structure, _) =
-            SymbolicSparseColMat::try_new_from_indices(n, n, &pairs).map_err(|_| NotPositiveDefinite)?;
+        let structure = column_structure(n, entries.chain((0..n).map(|i| (i, i))))?;
         let llt = SymbolicLlt::try_new(structure.as_ref(), Side::Lower).map_err(|_| NotPositiveDefinite)?;
         let mut analysis = Analysis { structure, llt, diagonal: Vec::new() };
         analysis.diagonal =
@@ -70,6 +67,48 @@ impl Analysis {
     }
 }
 
+/// The compressed-column pattern of the `n x n` positions `(row, column)` (any order, repeats
+/// allowed): bucketed by column, repeats dropped with a marker per row, rows sorted within
+/// each column (a pass over the positions, where a global sort of them would cost far more).
+fn column_structure(
+    n: usize,
+    positions: impl Iterator<Item = (usize, usize)>,
+) -> Result<SymbolicSparseColMat<usize>, NotPositiveDefinite> {
+    let positions: Vec<(usize, usize)> = positions.collect();
+    if positions.iter().any(|&(row, col)| row >= n || col >= n) {
+        return Err(NotPositiveDefinite);
+    }
+    let mut starts = vec![0; n + 1];
+    for &(_, col) in &positions {
+        starts[col + 1] += 1;
+    }
+    for col in 0..n {
+        starts[col + 1] += starts[col];
+    }
+    let mut next = starts.clone();
+    let mut bucketed = vec![0; positions.len()];
+    for &(row, col) in &positions {
+        bucketed[next[col]] = row;
+        next[col] += 1;
+    }
+    let mut seen_in = vec![usize::MAX; n];
+    let mut col_ptr = Vec::with_capacity(n + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for col in 0..n {
+        let first = row_idx.len();
+        for &row in &bucketed[starts[col]..starts[col + 1]] {
+            if seen_in[row] != col {
+                seen_in[row] = col;
+                row_idx.push(row);
+            }
+        }
+        row_idx[first..].sort_unstable();
+        col_ptr.push(row_idx.len());
+    }
+    Ok(SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx))
+}
+
 /// A Cholesky factorization of `A + shift I`, and the growing symbolic analysis behind it.
 #[derive(Default)]
 pub struct SpdSolver {
@@ -77,7 +116,8 @@ pub struct SpdSolver {
     /// Positions of the triplets of the last call, and the value slot of each.
     positions: Vec<(usize, usize)>,
     slots: Vec<Option<usize>>,
-    /// Values of the analysed pattern.
+    /// Values of the loaded matrix on the analysed pattern, and of the shifted one factored.
+    matrix: Vec<f64>,
     values: Vec<f64>,
     factor: Option<Llt<usize, f64>>,
     /// How many symbolic analyses were computed (for statistics).
@@ -93,17 +133,32 @@ impl SpdSolver {
         triplets: &[(usize, usize, f64)],
         shift: f64,
     ) -> Result<(), NotPositiveDefinite> {
+        self.load(n, triplets)?;
+        self.factor_shifted(shift)
+    }
+
+    /// Take the symmetric `n x n` matrix `A` given as triplets (duplicates summed; only the
+    /// lower triangle is read) for [`SpdSolver::factor_shifted`].
+    pub fn load(&mut self, n: usize, triplets: &[(usize, usize, f64)]) -> Result<(), NotPositiveDefinite> {
         if !self.same_positions(n, triplets) {
             self.map_positions(n, triplets)?;
         }
         let analysis = self.analysis.as_ref().ok_or(NotPositiveDefinite)?;
-        self.values.clear();
-        self.values.resize(analysis.structure.row_idx().len(), 0.0);
+        self.matrix.clear();
+        self.matrix.resize(analysis.structure.row_idx().len(), 0.0);
         for (&(_, _, v), slot) in triplets.iter().zip(&self.slots) {
             if let Some(k) = *slot {
-                self.values[k] += v;
+                self.matrix[k] += v;
             }
         }
+        Ok(())
+    }
+
+    /// Factor `A + shift I` for the `A` of the last [`SpdSolver::load`] (the shifts of a
+    /// regularization search need one pass over the triplets, not one each).
+    pub fn factor_shifted(&mut self, shift: f64) -> Result<(), NotPositiveDefinite> {
+        let analysis = self.analysis.as_ref().ok_or(NotPositiveDefinite)?;
+        self.values.clone_from(&self.matrix);
         for &k in &analysis.diagonal {
             self.values[k] += shift;
         }

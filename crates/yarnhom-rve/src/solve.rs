@@ -24,7 +24,7 @@
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
-use crate::assembly::{RveState, Want, assemble};
+use crate::assembly::{Assembled, ContactCandidates, RveState, Want, assemble, assemble_with};
 use crate::ccd::max_collision_free_step;
 use crate::linear::SpdSolver;
 use crate::model::RveModel;
@@ -213,7 +213,8 @@ pub fn solve_observed(
     let residual = |gradient: &DVector<f64>| projected(&c, gradient).norm();
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
-    let mut current = assemble(model, placement, state, &state.g, Want::Derivatives);
+    let mut assembler = Assembler::new(model, placement);
+    let mut current = assembler.assemble(state, &state.g, Want::Derivatives);
     let (reason, iterations) = 'solve: {
         for iteration in 0..options.max_iterations {
             let ratio = residual(&current.gradient) / first;
@@ -225,18 +226,9 @@ pub fn solve_observed(
             let t = iteration.min(options.regularization_iterations) as f64
                 / options.regularization_iterations as f64;
             let scaled_gradient = current.gradient.component_mul(&scale);
-            let mut alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
-            let scaled_hessian: Vec<(usize, usize, f64)> =
-                current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
-            let mut factored = false;
-            for _ in 0..30 {
-                if solver.factor(n, &scaled_hessian, alpha).is_ok() {
-                    factored = true;
-                    break;
-                }
-                alpha = (alpha * 10.0).max(1e-12);
-            }
-            if !factored {
+            let alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
+            scale_hessian(&mut current.hessian, &scale);
+            if !(solver.load(n, &current.hessian).is_ok() && factor_regularized(&mut solver, alpha)) {
                 break 'solve (StopReason::FactorizationFailed, iteration);
             }
             let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
@@ -254,7 +246,7 @@ pub fn solve_observed(
             let mut accepted = None;
             for _ in 0..12 {
                 let trial = &state.g + &step * length;
-                let e = assemble(model, placement, state, &trial, Want::EnergyGradient).energy_j;
+                let e = assembler.assemble(state, &trial, Want::Energy).energy_j;
                 if e < current.energy_j {
                     accepted = Some(trial);
                     break;
@@ -268,7 +260,7 @@ pub fn solve_observed(
             observe(&Iterate { iteration, energy_j, gradient_ratio: ratio, step_length: length, state });
             state.g = trial;
             state.update_frames(model, placement);
-            current = assemble(model, placement, state, &state.g, Want::Derivatives);
+            current = assembler.assemble(state, &state.g, Want::Derivatives);
         }
         (StopReason::IterationLimit, options.max_iterations)
     };
@@ -284,6 +276,55 @@ pub fn solve_observed(
         gradient_ratio: ratio,
         constraint_residual: (&c * &state.g - &target).amax(),
         symbolic_analyses: solver.symbolic_analyses,
+    }
+}
+
+/// Allowance of the contact candidates of a solve, in yarn radii: the broad phase is rerun
+/// once some vertex has moved this far from where it last ran (a few step-limited iterations).
+const CANDIDATE_ALLOWANCE_RADII: f64 = 0.5;
+
+/// The assembly of one solve's iterates under its placement, reusing the contact candidates
+/// ([`ContactCandidates`]) while they cover the iterate.
+struct Assembler<'a> {
+    model: &'a RveModel,
+    placement: &'a Placement,
+    candidates: Option<ContactCandidates>,
+}
+
+impl<'a> Assembler<'a> {
+    fn new(model: &'a RveModel, placement: &'a Placement) -> Self {
+        Assembler { model, placement, candidates: None }
+    }
+
+    /// [`assemble`] at DOFs `g`, measured against `state`'s frames.
+    fn assemble(&mut self, state: &RveState, g: &DVector<f64>, want: Want) -> Assembled {
+        let (model, placement) = (self.model, self.placement);
+        let candidates = match self.candidates.take() {
+            Some(c) if c.cover(model, g) => c,
+            _ => ContactCandidates::new(model, placement, g, CANDIDATE_ALLOWANCE_RADII * model.radius_m),
+        };
+        let assembled = assemble_with(model, placement, state, g, want, &candidates);
+        self.candidates = Some(candidates);
+        assembled
+    }
+}
+
+/// Factor the loaded `M H M + α I`, growing `α` tenfold while the matrix is indefinite (30
+/// times at most); whether it was factored.
+fn factor_regularized(solver: &mut SpdSolver, mut alpha: f64) -> bool {
+    for _ in 0..30 {
+        if solver.factor_shifted(alpha).is_ok() {
+            return true;
+        }
+        alpha = (alpha * 10.0).max(1e-12);
+    }
+    false
+}
+
+/// Scale the Hessian triplets to `M H M` for the diagonal `M` of `scale`.
+fn scale_hessian(hessian: &mut [(usize, usize, f64)], scale: &DVector<f64>) {
+    for (i, j, v) in hessian.iter_mut() {
+        *v = *v * scale[*i] * scale[*j];
     }
 }
 
@@ -314,14 +355,14 @@ pub fn equilibrium_response(
     let c = constraints(model, placement);
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * model.radius_m });
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
-    let current = assemble(model, placement, state, &state.g, Want::Derivatives);
-    let scaled_hessian: Vec<(usize, usize, f64)> =
-        current.hessian.iter().map(|&(i, j, v)| (i, j, v * scale[i] * scale[j])).collect();
+    let mut scaled_hessian = assemble(model, placement, state, &state.g, Want::Derivatives).hessian;
+    scale_hessian(&mut scaled_hessian, &scale);
     let largest =
         scaled_hessian.iter().filter(|(i, j, _)| i == j).map(|(_, _, v)| v.abs()).fold(0.0, f64::max);
     let mut solver = SpdSolver::default();
+    solver.load(n, &scaled_hessian).ok()?;
     let mut shift = RESPONSE_SHIFT * largest.max(1e-300);
-    while solver.factor(n, &scaled_hessian, shift).is_err() {
+    while solver.factor_shifted(shift).is_err() {
         shift *= 10.0;
         if shift > largest {
             return None;
