@@ -33,6 +33,16 @@ pub enum Want {
     EnergyGradient,
     /// Energy, gradient and Hessian.
     Derivatives,
+    /// Energy, gradient and the Hessian's lower triangle (`row >= column`): all that a
+    /// symmetric factorization reads ([`crate::linear::SpdSolver`]), in half the triplets.
+    DerivativesLower,
+}
+
+impl Want {
+    /// Whether the Hessian is wanted (whole or its lower triangle).
+    fn hessian(self) -> bool {
+        matches!(self, Want::Derivatives | Want::DerivativesLower)
+    }
 }
 
 /// The iterate of a tile solve: DOFs and the reference frames they are measured against.
@@ -158,6 +168,8 @@ struct Scatter<'a> {
     model: &'a RveModel,
     placement: &'a Placement,
     out: &'a mut Assembled,
+    /// Keep only the Hessian's lower triangle.
+    lower: bool,
 }
 
 impl Scatter<'_> {
@@ -184,13 +196,23 @@ impl Scatter<'_> {
         let Some(h) = h else { return };
         let at = |row: usize, col: usize| h[col * k + row];
         let block = |i: usize, j: usize| Matrix3::from_fn(|r, c| at(3 * i + r, 3 * j + c));
+        let lower = self.lower;
         let hessian = &mut self.out.hessian;
+        let mut push = |row: usize, col: usize, value: f64| {
+            if !lower || row >= col {
+                hessian.push((row, col, value));
+            }
+        };
         for i in 0..np {
             for j in 0..np {
+                if lower && base[j] > base[i] + 2 {
+                    // Above the diagonal.
+                    continue;
+                }
                 let pulled = rotation[i].transpose() * block(i, j) * rotation[j];
                 for r in 0..3 {
                     for c in 0..3 {
-                        hessian.push((base[i] + r, base[j] + c, pulled[(r, c)]));
+                        push(base[i] + r, base[j] + c, pulled[(r, c)]);
                     }
                 }
             }
@@ -202,14 +224,14 @@ impl Scatter<'_> {
                         at(3 * i + 2, 3 * np + t),
                     );
                 for r in 0..3 {
-                    hessian.push((base[i] + r, twist_index(t), column[r]));
-                    hessian.push((twist_index(t), base[i] + r, column[r]));
+                    push(base[i] + r, twist_index(t), column[r]);
+                    push(twist_index(t), base[i] + r, column[r]);
                 }
             }
         }
         for t in 0..twists.len() {
             for u in 0..twists.len() {
-                hessian.push((twist_index(t), twist_index(u), at(3 * np + t, 3 * np + u)));
+                push(twist_index(t), twist_index(u), at(3 * np + t, 3 * np + u));
             }
         }
     }
@@ -239,7 +261,8 @@ pub fn assemble_with(
 ) -> Assembled {
     let mut out =
         Assembled { energy_j: 0.0, gradient: DVector::zeros(model.dof_count()), hessian: Vec::new() };
-    let derivatives = want == Want::Derivatives;
+    let derivatives = want.hessian();
+    let lower = want == Want::DerivativesLower;
     if derivatives {
         out.hessian.reserve(hessian_capacity(model, candidates.pairs.len()));
     }
@@ -250,7 +273,7 @@ pub fn assemble_with(
         out.energy_j += e;
         if want != Want::Energy {
             let h = derivatives.then_some(hess.as_slice());
-            Scatter { model, placement, out: &mut out }.add(&[s.from, s.to], &[], grad.as_slice(), h);
+            Scatter { model, placement, out: &mut out, lower }.add(&[s.from, s.to], &[], grad.as_slice(), h);
         }
     }
     for (k, b) in model.bends.iter().enumerate() {
@@ -260,7 +283,7 @@ pub fn assemble_with(
         if derivatives {
             let (e, grad, hess) = b.element.energy_gradient_hessian(&reference, &q);
             out.energy_j += e;
-            Scatter { model, placement, out: &mut out }.add(
+            Scatter { model, placement, out: &mut out, lower }.add(
                 &[b.prev, b.vertex, b.next],
                 &twists,
                 grad.as_slice(),
@@ -281,16 +304,18 @@ fn hessian_capacity(model: &RveModel, pairs: usize) -> usize {
     model.stretch.len() * dense(6) + model.bends.len() * dense(11) + pairs * dense(12)
 }
 
-/// The edge pairs that may come within contact reach while no vertex moves more than an
-/// allowance from the DOFs they were found at (a Verlet list): the broad phase
-/// ([`crate::broadphase`]) on the edges' boxes grown by half the reach plus the allowance. Under
-/// one placement a vertex instance moves by `|R Δg_v| = |Δg_v|`, so each edge's box at DOFs
-/// within the allowance lies in its grown box, and every pair within reach there is a candidate.
+/// The edge pairs that may come within contact reach while no vertex instance moves more than
+/// an allowance from where they were found (a Verlet list): the broad phase
+/// ([`crate::broadphase`]) on the edges' boxes grown by half the reach plus the allowance. Each
+/// edge's box after such moves lies in its grown box, so every pair within reach then is a
+/// candidate.
 #[derive(Debug, Clone)]
 pub struct ContactCandidates {
     /// DOFs the pairs were found at.
     g: DVector<f64>,
-    /// Largest vertex move they allow (m).
+    /// The edges' ends there, as `[image][edge]` ([`image_segments`]).
+    ends: Vec<Vec<(Vector3<f64>, Vector3<f64>)>>,
+    /// Largest move of a vertex instance they allow (m).
     allowance: f64,
     /// The candidate pairs, sorted.
     pairs: Vec<EdgePair>,
@@ -301,11 +326,12 @@ pub struct ContactCandidates {
 }
 
 impl ContactCandidates {
-    /// The candidates at DOFs `g` under `placement` for vertex moves up to `allowance` (m).
+    /// The candidates at DOFs `g` under `placement` for moves up to `allowance` (m).
     pub fn new(model: &RveModel, placement: &Placement, g: &DVector<f64>, allowance: f64) -> Self {
         // The relative 1e-9 keeps pairs whose quadrature points round to just within reach.
         let margin = 0.5 * model.contact.reach_m() * (1.0 + 1e-9) + allowance;
-        let boxes: Vec<Vec<Aabb>> = image_segments(model, placement, g)
+        let ends = image_segments(model, placement, g);
+        let boxes: Vec<Vec<Aabb>> = ends
             .iter()
             .map(|e| e.iter().map(|(p, q)| Aabb::around_segment(p, q, margin)).collect())
             .collect();
@@ -323,16 +349,29 @@ impl ContactCandidates {
                 *k
             })
             .collect();
-        ContactCandidates { g: g.clone(), allowance, pairs, image_edges, image_edge }
+        ContactCandidates { g: g.clone(), ends, allowance, pairs, image_edges, image_edge }
     }
 
-    /// Whether the candidates hold at DOFs `g`: no vertex moved more than the allowance.
+    /// Whether the candidates hold at DOFs `g` under the placement they were found in: no
+    /// vertex moved more than the allowance (an instance moves by `|R Δg_v| = |Δg_v|`).
     pub fn cover(&self, model: &RveModel, g: &DVector<f64>) -> bool {
         (0..model.vertices as u32).all(|v| {
             let k = model.position_dof(v);
             let moved = Vector3::new(g[k] - self.g[k], g[k + 1] - self.g[k + 1], g[k + 2] - self.g[k + 2]);
             moved.norm() <= self.allowance
         })
+    }
+
+    /// Whether the candidates hold at DOFs `g` under another `placement` (a nearby strain): no
+    /// edge end in any image moved more than the allowance.
+    pub fn cover_placed(&self, model: &RveModel, placement: &Placement, g: &DVector<f64>) -> bool {
+        let within = |(p, q): &(Vector3<f64>, Vector3<f64>), (p0, q0): &(Vector3<f64>, Vector3<f64>)| {
+            (p - p0).norm() <= self.allowance && (q - q0).norm() <= self.allowance
+        };
+        image_segments(model, placement, g)
+            .iter()
+            .zip(&self.ends)
+            .all(|(now, then)| now.iter().zip(then).all(|(a, b)| within(a, b)))
     }
 }
 
@@ -377,10 +416,11 @@ fn add_contacts(
         if want == Want::Energy {
             continue;
         }
-        let h = (want == Want::Derivatives).then_some(hess.as_slice());
+        let h = want.hessian().then_some(hess.as_slice());
         let (sa, sb, o) = (model.stretch[a], model.stretch[b], model.images[image]);
         let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
-        Scatter { model, placement, out: &mut *out }.add(&instances, &[], grad.as_slice(), h);
+        let lower = want == Want::DerivativesLower;
+        Scatter { model, placement, out: &mut *out, lower }.add(&instances, &[], grad.as_slice(), h);
     }
 }
 

@@ -4,7 +4,7 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use yarnhom_geom::{MacroStrain, StrainError};
 
-use crate::assembly::{RveState, Want, assemble};
+use crate::assembly::{ContactCandidates, RveState, Want, assemble, assemble_with};
 use crate::model::RveModel;
 use crate::placement::Placement;
 use crate::solve::{
@@ -56,6 +56,11 @@ pub fn solve_at_observed(
 /// so the step only trades truncation against round-off of the energy.
 const EMBEDDING_STEP: f64 = 1e-6;
 
+/// Allowance of the contact candidates shared by the shifted placements of
+/// [`stress_at_equilibrium`], in yarn radii (an embedding step moves the yarns by about
+/// `10⁻⁶` of the tile's size).
+const EMBEDDING_ALLOWANCE_RADII: f64 = 0.01;
+
 /// Homogenized stress `dΨ/d(sx, sa, sy, kx, ky)` (3.23c) at the equilibrium `state` of `strain`,
 /// from the forces the yarns exert at equilibrium, without another solve.
 ///
@@ -70,6 +75,9 @@ pub fn stress_at_equilibrium(model: &RveModel, strain: &MacroStrain, state: &Rve
     let here = placement(model, strain);
     let c = constraints(model, &here);
     let lambda = multipliers(&c, &assemble(model, &here, state, &state.g, Want::EnergyGradient).gradient);
+    // The embedding steps move the yarns far less than this: one broad phase serves them all.
+    let candidates =
+        ContactCandidates::new(model, &here, &state.g, EMBEDDING_ALLOWANCE_RADII * model.radius_m);
     let base = strain_vector(strain);
     let mut stress = [0.0; 5];
     for (k, slot) in stress.iter_mut().enumerate() {
@@ -78,7 +86,11 @@ pub fn stress_at_equilibrium(model: &RveModel, strain: &MacroStrain, state: &Rve
             let mut s = base;
             s[k] += sign * h;
             let shifted = placement(model, &strain_from_vector(s).unwrap_or(*strain));
-            let energy = assemble(model, &shifted, state, &state.g, Want::Energy).energy_j;
+            let energy = if candidates.cover_placed(model, &shifted, &state.g) {
+                assemble_with(model, &shifted, state, &state.g, Want::Energy, &candidates).energy_j
+            } else {
+                assemble(model, &shifted, state, &state.g, Want::Energy).energy_j
+            };
             (energy, constraints(model, &shifted) * &state.g)
         };
         let ((e_plus, c_plus), (e_minus, c_minus)) = (at(1.0), at(-1.0));

@@ -214,7 +214,7 @@ pub fn solve_observed(
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
     let mut assembler = Assembler::new(model, placement);
-    let mut current = assembler.assemble(state, &state.g, Want::Derivatives);
+    let mut current = assembler.assemble(state, &state.g, Want::DerivativesLower);
     let (reason, iterations) = 'solve: {
         for iteration in 0..options.max_iterations {
             let ratio = residual(&current.gradient) / first;
@@ -260,7 +260,7 @@ pub fn solve_observed(
             observe(&Iterate { iteration, energy_j, gradient_ratio: ratio, step_length: length, state });
             state.g = trial;
             state.update_frames(model, placement);
-            current = assembler.assemble(state, &state.g, Want::Derivatives);
+            current = assembler.assemble(state, &state.g, Want::DerivativesLower);
         }
         (StopReason::IterationLimit, options.max_iterations)
     };
@@ -355,7 +355,7 @@ pub fn equilibrium_response(
     let c = constraints(model, placement);
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * model.radius_m });
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
-    let mut scaled_hessian = assemble(model, placement, state, &state.g, Want::Derivatives).hessian;
+    let mut scaled_hessian = assemble(model, placement, state, &state.g, Want::DerivativesLower).hessian;
     scale_hessian(&mut scaled_hessian, &scale);
     let largest =
         scaled_hessian.iter().filter(|(i, j, _)| i == j).map(|(_, _, v)| v.abs()).fold(0.0, f64::max);
