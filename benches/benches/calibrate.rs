@@ -51,6 +51,7 @@ fn stockinette_membrane() -> StvkNeoHookean {
         k_n1: 0.84,
         k_n2: 232.2,
         stiffening: None,
+        jamming: None,
     }
 }
 

@@ -51,6 +51,9 @@ pub enum MembraneModel {
     Stvk,
     /// Anisotropic StVK with the Neo-Hookean area terms (6.1).
     StvkNeoHookean,
+    /// (6.1) with jamming past an onset compression ([`StvkNeoHookean::jamming`]): the
+    /// extension the diagnosis names `two-phase-contact` (beyond the thesis).
+    StvkNeoHookeanJamming,
 }
 
 /// How to fit.
@@ -227,15 +230,22 @@ pub(crate) struct Terms {
     pub area: bool,
     /// [`Stiffening`] past an onset strain.
     pub stiffening: bool,
+    /// Jamming ([`StvkNeoHookean::jamming`]) past an onset compression.
+    pub jamming: bool,
 }
 
 impl From<MembraneModel> for Terms {
     fn from(model: MembraneModel) -> Self {
-        Terms { area: model == MembraneModel::StvkNeoHookean, stiffening: false }
+        Terms {
+            area: model != MembraneModel::Stvk,
+            stiffening: false,
+            jamming: model == MembraneModel::StvkNeoHookeanJamming,
+        }
     }
 }
 
-/// The fitted parameters: logs of the positive stiffnesses (and of the stiffening onset) and
+/// The fitted parameters: logs of the positive stiffnesses (and of the stiffening and jamming
+/// onsets) and
 /// `atanh` of the coupling ratio `k_xy / √(k_xx k_yy)`, which keeps the StVK matrix positive
 /// definite.
 #[derive(Debug, Clone, Copy)]
@@ -259,6 +269,10 @@ impl Parameterization {
             let b = m.stiffening.expect("a stiffening term to encode");
             p.extend([b.k_weft.ln(), b.k_warp.ln(), b.onset.ln()]);
         }
+        if self.terms.jamming {
+            let b = m.jamming.expect("a jamming term to encode");
+            p.extend([b.k_weft.ln(), b.k_warp.ln(), b.onset.ln()]);
+        }
         p
     }
 
@@ -275,6 +289,9 @@ impl Parameterization {
         }
         if self.terms.stiffening {
             m.stiffening = Some(Stiffening { k_weft: next(), k_warp: next(), onset: next() });
+        }
+        if self.terms.jamming {
+            m.jamming = Some(Stiffening { k_weft: next(), k_warp: next(), onset: next() });
         }
         m
     }
@@ -411,7 +428,10 @@ pub(crate) fn collect_errors(
 
 /// A starting material from the last target of each direction: `k ≈ σ / ((1 + s) E)` with
 /// `E = ((1 + s)² - 1) / 2`, the other axis copying a missing one; area terms at 5% of the
-/// mean stiffness; stiffening as stiff as the StVK part, from half the largest Green strain.
+/// mean stiffness; stiffening as stiff as the StVK part, from half the largest Green strain;
+/// jamming as stiff as the mean StVK stiffness, from a quarter of the largest compressive Green
+/// strain measured across a weft or warp pull (the axes the jamming acts on; a bias swatch
+/// contracts by shear), so that it acts on most targets from the start.
 pub(crate) fn starting_material(data: &[DirectionData], terms: Terms) -> StvkNeoHookean {
     let stiffness = |direction: Direction| {
         data.iter().find(|d| d.direction == direction).and_then(|d| d.targets.last().map(|t| (d, t))).map(
@@ -429,6 +449,13 @@ pub(crate) fn starting_material(data: &[DirectionData], terms: Terms) -> StvkNeo
     let area = if terms.area { 0.05 * mean } else { 0.0 };
     let largest = data.iter().flat_map(|d| d.targets.iter().map(|t| t.stretch)).fold(0.0, f64::max);
     let onset = 0.25 * ((1.0 + largest).powi(2) - 1.0);
+    let most_compressed = data
+        .iter()
+        .filter(|d| d.direction != Direction::Bias)
+        .flat_map(|d| d.targets.iter().filter_map(|t| t.compression))
+        .fold(0.0, f64::max)
+        .min(0.9);
+    let jamming_onset = 0.125 * (1.0 - (1.0 - most_compressed).powi(2));
     StvkNeoHookean {
         k_xx,
         k_yy,
@@ -440,6 +467,11 @@ pub(crate) fn starting_material(data: &[DirectionData], terms: Terms) -> StvkNeo
             k_weft: k_xx,
             k_warp: k_yy,
             onset: onset.max(1e-3),
+        }),
+        jamming: terms.jamming.then_some(Stiffening {
+            k_weft: mean,
+            k_warp: mean,
+            onset: jamming_onset.max(1e-3),
         }),
     }
 }
@@ -507,20 +539,17 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
     let targets = targets(set, &settings.plan)?;
     let problem = Problem::new(DirectionData::group(set, &targets, |_| true), settings.spacing_m);
     let terms = Terms::from(settings.model);
-    let start = starting_material(&problem.data, terms);
-    let parameterization = Parameterization {
-        terms,
-        fit_shear: problem.data.iter().any(|d| d.direction == Direction::Bias),
-        held: start,
+    let start = if terms.jamming {
+        // Nested: from the (6.1) fit, with the jamming a thousandth of its starting size.
+        let plain = fit_membrane(&problem, Terms { jamming: false, ..terms }, None, &settings.lm)?.material;
+        let seed = starting_material(&problem.data, terms);
+        Some(StvkNeoHookean { jamming: seed.jamming.map(Stiffening::faint), ..plain })
+    } else {
+        None
     };
-    let prior = parameterization.encode(&start);
-    let screened = problem.screen(&parameterization, &prior, &settings.lm);
-    let screening = parameterization.decode(&screened);
+    let FittedMembrane { screening, optimizer, material, unconstrained } =
+        fit_membrane(&problem, terms, start, &settings.lm)?;
     let screening_simulated = problem.simulate(&screening).ok_or(ShellFitError::Start(screening))?;
-    let optimizer = problem
-        .refine(&parameterization, &screened, &prior, &settings.lm)
-        .ok_or(ShellFitError::Start(screening))?;
-    let material = parameterization.decode(&optimizer.params);
     let fitted = problem.simulate(&material).ok_or(ShellFitError::Start(material))?;
     let finer = Problem::new(DirectionData::group(set, &targets, |_| true), 0.5 * settings.spacing_m);
     let refined = finer.simulate(&material);
@@ -533,7 +562,7 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         screening,
         screening_errors: collect_errors(data, &screening_simulated, true),
         material,
-        unconstrained: parameterization.unconstrained(),
+        unconstrained,
         errors: collect_errors(data, &fitted, true),
         mesh_refinement_change: refined.map(|r| largest_relative_change(&fitted, &r)),
         optimizer,
@@ -544,6 +573,56 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         simulated: fitted.into_iter().flatten().collect(),
         targets,
     })
+}
+
+/// A membrane fitted by [`fit_membrane`].
+pub(crate) struct FittedMembrane {
+    /// The material fitted to the uniform test (the screening).
+    pub screening: StvkNeoHookean,
+    /// The simulation-in-the-loop refinement.
+    pub optimizer: LmReport,
+    /// The fitted material.
+    pub material: StvkNeoHookean,
+    /// The parameters the data do not constrain (held at their start).
+    pub unconstrained: Vec<String>,
+}
+
+/// Fit `terms` to the problem's fitted targets: screen on the uniform test from `start`
+/// (default: [`starting_material`]), then refine on the clamped swatches from the better of
+/// the screened point and `start`, with the prior at `start`.
+pub(crate) fn fit_membrane(
+    problem: &Problem,
+    terms: Terms,
+    start: Option<StvkNeoHookean>,
+    lm: &LmSettings,
+) -> Result<FittedMembrane, ShellFitError> {
+    let start = start.unwrap_or_else(|| starting_material(&problem.data, terms));
+    let parameterization = Parameterization {
+        terms,
+        fit_shear: problem.data.iter().any(|d| d.direction == Direction::Bias),
+        held: start,
+    };
+    let prior = parameterization.encode(&start);
+    let screened = problem.screen(&parameterization, &prior, lm);
+    let screening = parameterization.decode(&screened);
+    let cost = |p: &[f64]| {
+        let readings = problem.simulate(&parameterization.decode(p))?;
+        let r = problem.data.iter().zip(&readings).flat_map(|(d, r)| {
+            let (f, c) = forces_and_compressions(r);
+            d.residuals(&f, &c, true)
+        });
+        Some(r.map(|x| x * x).sum::<f64>())
+    };
+    let from = [screened, prior.clone()]
+        .into_iter()
+        .filter_map(|p| cost(&p).map(|c| (c, p)))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .map(|(_, p)| p)
+        .ok_or(ShellFitError::Start(start))?;
+    let optimizer =
+        problem.refine(&parameterization, &from, &prior, lm).ok_or(ShellFitError::Start(start))?;
+    let material = parameterization.decode(&optimizer.params);
+    Ok(FittedMembrane { screening, optimizer, material, unconstrained: parameterization.unconstrained() })
 }
 
 fn largest_relative_change(a: &[Vec<SimulatedReading>], b: &[Vec<SimulatedReading>]) -> f64 {
@@ -592,6 +671,7 @@ mod tests {
             k_n1: 4.0,
             k_n2: 1.5,
             stiffening: None,
+            jamming: None,
         }
     }
 

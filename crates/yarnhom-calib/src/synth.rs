@@ -23,6 +23,9 @@ pub enum HiddenEffect {
     AreaPreservation,
     /// Stiffening past an onset strain ([`yarnhom_shell::Stiffening`]).
     BiphasicStretch,
+    /// Jamming past an onset compression ([`StvkNeoHookean::jamming`]), the shell-level trace
+    /// of two-phase yarn contact: the contraction across the pull stops growing near 2%.
+    TwoPhaseContact,
     /// Unloading readings below loading: a friction force `2 h f_max` opposes the unloading
     /// swatch (a constant offset, not the multiplicative form the diagnosis fits).
     FrictionHysteresis,
@@ -30,6 +33,11 @@ pub enum HiddenEffect {
     RestCurvature,
     /// Bending stiffness differs by direction (weft stiffer than warp).
     AnisotropicBending,
+    /// Not in the diagnosis' catalog: the fabric softens past an onset strain (a negative
+    /// [`Stiffening`] taking 70% of the weft and warp stiffness away), so the force rises
+    /// slower than any strain-independent membrane allows; an honest diagnosis says
+    /// `unexplained`.
+    Softening,
 }
 
 /// The truth of a synthetic set.
@@ -65,6 +73,7 @@ pub fn ground_truth(effect: HiddenEffect, strength: f64) -> GroundTruth {
         k_n1: 0.0,
         k_n2: 0.0,
         stiffening: None,
+        jamming: None,
     };
     let base =
         GroundTruth { membrane, unload_friction: 0.0, bending: HingeBending::isotropic(BASE_BENDING_J) };
@@ -85,7 +94,25 @@ pub fn ground_truth(effect: HiddenEffect, strength: f64) -> GroundTruth {
             },
             ..base
         },
+        HiddenEffect::TwoPhaseContact => GroundTruth {
+            membrane: StvkNeoHookean {
+                jamming: Some(Stiffening { k_weft: 400.0 * strength, k_warp: 400.0 * strength, onset: 0.02 }),
+                ..membrane
+            },
+            ..base
+        },
         HiddenEffect::FrictionHysteresis => GroundTruth { unload_friction: 0.08 * strength, ..base },
+        HiddenEffect::Softening => GroundTruth {
+            membrane: StvkNeoHookean {
+                stiffening: Some(Stiffening {
+                    k_weft: -0.7 * strength.min(1.0) * membrane.k_xx,
+                    k_warp: -0.7 * strength.min(1.0) * membrane.k_yy,
+                    onset: 0.03,
+                }),
+                ..membrane
+            },
+            ..base
+        },
         HiddenEffect::RestCurvature => {
             let curl = 25.0 * strength;
             GroundTruth {

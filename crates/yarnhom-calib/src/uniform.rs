@@ -138,6 +138,7 @@ mod tests {
             k_n1: 0.0,
             k_n2: 0.0,
             stiffening: None,
+            jamming: None,
         };
         for direction in Direction::ALL {
             let p = uniaxial(&m, direction, 1e-5);

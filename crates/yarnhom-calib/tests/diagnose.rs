@@ -77,12 +77,12 @@ fn a_hidden_bending_anisotropy_is_found() {
 }
 
 #[test]
-fn without_bending_tests_the_bending_causes_and_two_phase_contact_say_why_not() {
+fn without_bending_tests_the_bending_causes_say_why_not() {
     let d = hidden(HiddenEffect::AreaPreservation, 1.0, 12, false);
     assert_eq!(d.cause.id, CauseId::AreaPreservation, "{:#?}", d.cause);
     assert!(d.gain.heldout_error_after < 0.75 * d.gain.heldout_error_before);
     assert!(d.bending.is_none());
-    for id in ["two-phase-contact", "rest-curvature", "anisotropic-bending"] {
+    for id in ["rest-curvature", "anisotropic-bending"] {
         let c = d.candidates.iter().find(|c| c.id == id).expect("every catalog candidate is reported");
         assert!(!c.testable && c.note.as_ref().is_some_and(|n| !n.is_empty()), "{c:?}");
     }
@@ -92,6 +92,24 @@ fn without_bending_tests_the_bending_causes_and_two_phase_contact_say_why_not() 
 fn a_hidden_stiffening_is_found_as_biphasic_stretch() {
     let d = hidden(HiddenEffect::BiphasicStretch, 1.0, 13, false);
     assert_eq!(d.cause.id, CauseId::BiphasicStretch, "{:#?}", d.cause);
+}
+
+#[test]
+fn a_hidden_jamming_is_found_as_two_phase_contact() {
+    let d = hidden(HiddenEffect::TwoPhaseContact, 1.0, 17, false);
+    assert_eq!(d.cause.id, CauseId::TwoPhaseContact, "{:#?}", d.cause);
+    let params = &d.extended.as_ref().expect("extended").params;
+    let onset = params.iter().find(|p| p.0 == "jamming_onset").expect("an onset").1;
+    assert!((onset / 0.02 - 1.0).abs() < 0.5, "jamming onset {onset} vs 0.02 hidden");
+    assert!(d.gain.heldout_error_after < 0.5 * d.gain.heldout_error_before, "{:?}", d.gain);
+}
+
+#[test]
+fn an_effect_outside_the_catalog_is_unexplained() {
+    let d = hidden(HiddenEffect::Softening, 1.0, 18, false);
+    assert_eq!(d.cause.id, CauseId::Unexplained, "{:#?}", d.cause);
+    assert!(d.extended.is_none());
+    assert!(d.base.heldout_error.expect("held out") > 3.0 * d.noise, "structured residuals: {:?}", d.base);
 }
 
 #[test]

@@ -1,11 +1,11 @@
 //! The real acrylic swatches of `shared/data/stitch-by-stitch-acrylic` calibrated end to end:
-//! the README's shell-fit and diagnosis tables (about 100 s on 2 cores; `-- --nocapture`
+//! the README's shell-fit and diagnosis tables (about 4 min on 2 cores; `-- --nocapture`
 //! prints them).
 
 #![cfg(feature = "hdf5")]
 
 use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, diagnose};
-use yarnhom_calib::shell_fit::{ShellFitSettings, fit_shell};
+use yarnhom_calib::shell_fit::{MembraneModel, ShellFitSettings, fit_shell};
 use yarnhom_calib::stitch_by_stitch::import_fabric;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic");
@@ -13,6 +13,7 @@ const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/st
 #[test]
 fn real_acrylic_swatches_fit_and_diagnose() {
     let (mut force, mut compression) = (Vec::new(), Vec::new());
+    let (mut jammed_force, mut jammed_compression) = (Vec::new(), Vec::new());
     for pattern in ["stockinette", "garter", "rib", "seed"] {
         let files = ["x", "y"].map(|d| format!("{DATA}/acrylic-{pattern}-{d}.h5").into());
         let set = import_fabric(&files, 1).expect("imports").set;
@@ -31,6 +32,17 @@ fn real_acrylic_swatches_fit_and_diagnose() {
         force.push(fit.errors.force);
         compression.push(fit.errors.compression.expect("measured"));
 
+        let settings = ShellFitSettings { model: MembraneModel::StvkNeoHookeanJamming, ..Default::default() };
+        let jammed = fit_shell(&set, &settings).expect("fits");
+        eprintln!(
+            "  with jamming: force {:.1}%, compression {:.1}%, {:?}",
+            100.0 * jammed.errors.force,
+            100.0 * jammed.errors.compression.expect("measured"),
+            jammed.material.jamming
+        );
+        jammed_force.push(jammed.errors.force);
+        jammed_compression.push(jammed.errors.compression.expect("measured"));
+
         let d = diagnose(&set, &DiagnoseSettings::default()).expect("diagnoses");
         eprintln!(
             "  diagnosis: {} ({:.3} -> {:.3})",
@@ -48,8 +60,23 @@ fn real_acrylic_swatches_fit_and_diagnose() {
     }
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     eprintln!("mean: force {:.1}%, compression {:.1}%", 100.0 * mean(&force), 100.0 * mean(&compression));
-    // Thesis Sec. 6.3.1 over 33 fabrics: 17.59% force, 16.84% compression. Force is met;
-    // compression is not (20.6%, README), guarded here against getting worse.
+    eprintln!(
+        "mean with jamming: force {:.1}%, compression {:.1}%",
+        100.0 * mean(&jammed_force),
+        100.0 * mean(&jammed_compression)
+    );
+    // Thesis Sec. 6.3.1 over 33 fabrics: 17.59% force, 16.84% compression. With (6.1) alone
+    // force is met and compression is not (20.6%, README), guarded here against getting worse;
+    // with the jamming the diagnosis finds (`two-phase-contact`), both are met.
     assert!(mean(&force) <= 0.1759, "force error {}", mean(&force));
     assert!(mean(&compression) <= 0.22, "compression error {}", mean(&compression));
+    assert!(mean(&jammed_force) <= 0.1759, "force error with jamming {}", mean(&jammed_force));
+    assert!(
+        mean(&jammed_compression) <= 0.1684,
+        "compression error with jamming {}",
+        mean(&jammed_compression)
+    );
+    for (j, plain) in jammed_compression.iter().zip(&compression) {
+        assert!(*j <= plain + 0.01, "the nested fit does not lose compression: {j} vs {plain}");
+    }
 }

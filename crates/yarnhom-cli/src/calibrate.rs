@@ -116,9 +116,12 @@ pub enum EffectArg {
     None,
     AreaPreservation,
     BiphasicStretch,
+    TwoPhaseContact,
     FrictionHysteresis,
     RestCurvature,
     AnisotropicBending,
+    /// Off the catalog (softening past an onset): the diagnosis should say `unexplained`.
+    Softening,
 }
 
 #[derive(Debug, Args)]
@@ -158,6 +161,8 @@ pub enum ModelArg {
     Stvk,
     /// StVK with the Neo-Hookean area terms (6.1).
     StvkNeoHookean,
+    /// (6.1) with jamming past an onset compression (the `two-phase-contact` extension).
+    StvkNeoHookeanJamming,
 }
 
 #[derive(Debug, Args)]
@@ -210,6 +215,7 @@ fn shell(args: ShellArgs) -> Result<Outcome> {
         model: match args.model {
             ModelArg::Stvk => MembraneModel::Stvk,
             ModelArg::StvkNeoHookean => MembraneModel::StvkNeoHookean,
+            ModelArg::StvkNeoHookeanJamming => MembraneModel::StvkNeoHookeanJamming,
         },
         spacing_m: args.spacing,
         ..ShellFitSettings::default()
@@ -395,9 +401,11 @@ fn synth(args: SynthArgs) -> Result<Outcome> {
         EffectArg::None => HiddenEffect::None,
         EffectArg::AreaPreservation => HiddenEffect::AreaPreservation,
         EffectArg::BiphasicStretch => HiddenEffect::BiphasicStretch,
+        EffectArg::TwoPhaseContact => HiddenEffect::TwoPhaseContact,
         EffectArg::FrictionHysteresis => HiddenEffect::FrictionHysteresis,
         EffectArg::RestCurvature => HiddenEffect::RestCurvature,
         EffectArg::AnisotropicBending => HiddenEffect::AnisotropicBending,
+        EffectArg::Softening => HiddenEffect::Softening,
     };
     let truth = ground_truth(effect, args.strength);
     let name = args.output.file_name().and_then(|n| n.to_str()).unwrap_or("synthetic").to_string();
@@ -490,6 +498,7 @@ fn model_name(model: MembraneModel) -> &'static str {
     match model {
         MembraneModel::Stvk => "anisotropic StVK",
         MembraneModel::StvkNeoHookean => "anisotropic StVK + Neo-Hookean (6.1)",
+        MembraneModel::StvkNeoHookeanJamming => "anisotropic StVK + Neo-Hookean (6.1) + jamming",
     }
 }
 
@@ -507,6 +516,12 @@ fn summary(fit: &ShellFit) -> String {
             m.k_xx, m.k_xy, m.k_yy, m.k_ss, m.k_n1, m.k_n2
         ),
     ];
+    if let Some(j) = m.jamming {
+        lines.push(format!(
+            "  jamming past compressive Green strain {:.4}: k_weft {:.4} k_warp {:.4} (J/m²)",
+            j.onset, j.k_weft, j.k_warp
+        ));
+    }
     if !fit.unconstrained.is_empty() {
         lines.push(format!("  not constrained by the data (held): {}", fit.unconstrained.join(", ")));
     }

@@ -13,7 +13,16 @@ fn yarnhom(args: &[&str], cwd: &Path) -> Output {
 
 /// The membrane behind the synthetic sets.
 fn known_membrane() -> StvkNeoHookean {
-    StvkNeoHookean { k_xx: 80.0, k_xy: 10.0, k_yy: 30.0, k_ss: 12.0, k_n1: 3.0, k_n2: 1.0, stiffening: None }
+    StvkNeoHookean {
+        k_xx: 80.0,
+        k_xy: 10.0,
+        k_yy: 30.0,
+        k_ss: 12.0,
+        k_n1: 3.0,
+        k_n2: 1.0,
+        stiffening: None,
+        jamming: None,
+    }
 }
 
 fn text(bytes: &[u8]) -> String {
@@ -126,7 +135,9 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
     assert!(after < before, "{after} vs {before}");
     let md = std::fs::read_to_string(dir.path().join("out/report.md")).expect("md");
     assert!(
-        md.contains("**Cause: `friction-hysteresis`**") && md.contains("| two-phase-contact | no |"),
+        md.contains("**Cause: `friction-hysteresis`**")
+            && md.contains("| two-phase-contact | yes |")
+            && md.contains("| rest-curvature | no |"),
         "{md}"
     );
     for figure in ["fit.svg", "residuals.svg"] {

@@ -287,6 +287,7 @@ mod tests {
                 k_n1: 0.2,
                 k_n2: 0.1,
                 stiffening: None,
+                jamming: None,
             },
             HingeBending {
                 k_weft: 1e-4,

@@ -31,11 +31,19 @@ pub struct StvkNeoHookean {
     /// Stiffening past an onset strain, if any (not part of (6.1)).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub stiffening: Option<Stiffening>,
+    /// Jamming past an onset compression, if any (not part of (6.1)): the same one-sided term
+    /// on the compressive Green strain, `½ k_weft ⟨-E11 - onset⟩₊² + ½ k_warp ⟨-E22 - onset⟩₊²`,
+    /// the shell-level analogue of the two-phase contact (6.7): the fabric contracts freely
+    /// across a pull while its yarns' soft outer contact layers give, and stiffly once they are
+    /// pressed onto the hard inner cores.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jamming: Option<Stiffening>,
 }
 
 /// A biphasic membrane: `½ k_weft ⟨E11 - onset⟩₊² + ½ k_warp ⟨E22 - onset⟩₊²` added to (6.1),
 /// the shell-level analogue of the biphasic yarn stretch (6.5): the fabric stiffens once its
-/// Green strain along an axis passes `onset`.
+/// Green strain along an axis passes `onset`. As [`StvkNeoHookean::jamming`] the same term
+/// acts on compression, `⟨-E - onset⟩₊`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 #[serde(deny_unknown_fields)]
 pub struct Stiffening {
@@ -66,6 +74,14 @@ pub struct HingeBending {
     /// Rest curvature of the warp direction (1/m).
     #[serde(default)]
     pub rest_curvature_warp: f64,
+}
+
+impl Stiffening {
+    /// The same onset with a thousandth of the stiffness: where a nested fit starts the term,
+    /// so that the extended model starts where the model without it ended.
+    pub fn faint(self) -> Self {
+        Self { k_weft: 1e-3 * self.k_weft, k_warp: 1e-3 * self.k_warp, ..self }
+    }
 }
 
 impl HingeBending {
@@ -167,20 +183,14 @@ impl StvkNeoHookean {
         let ddg = 2.0 * self.k_n1 + 2.0 * self.k_n2 * (1.0 - log_j) / (j * j);
         let mut gradient = stvk_gradient + dg * d_j;
         let mut hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
-        let mut stiffening = 0.0;
-        if let Some(b) = &self.stiffening {
-            // E11 = (I11 - 1)/2 and E22 = (I22 - 1)/2: dE/dI = 1/2.
-            for (index, strain, k) in [(0, eps[0], b.k_weft), (2, eps[1], b.k_warp)] {
-                let excess = (strain - b.onset).max(0.0);
-                stiffening += 0.5 * k * excess * excess;
-                gradient[index] += 0.5 * k * excess;
-                if excess > 0.0 {
-                    hessian[(index, index)] += 0.25 * k;
-                }
+        let mut one_sided = 0.0;
+        for (term, sign) in [(&self.stiffening, 1.0), (&self.jamming, -1.0)] {
+            if let Some(b) = term {
+                one_sided += add_one_sided_term(b, sign, &eps, &mut gradient, &mut hessian);
             }
         }
         let mut jet = EnergyJet {
-            value: 0.5 * eps.dot(&(k * eps)) + g + stiffening,
+            value: 0.5 * eps.dot(&(k * eps)) + g + one_sided,
             gradient: Vector6::zeros(),
             hessian: Default::default(),
         };
@@ -188,6 +198,29 @@ impl StvkNeoHookean {
         jet.hessian.fixed_view_mut::<3, 3>(0, 0).copy_from(&hessian);
         jet
     }
+}
+
+/// Add `½ k ⟨sign E - onset⟩₊²` on `E11` (`k_weft`) and `E22` (`k_warp`) to the derivatives in
+/// `(I11, I12, I22)`, returning its value; `sign` is 1 for [`StvkNeoHookean::stiffening`], -1
+/// for [`StvkNeoHookean::jamming`].
+fn add_one_sided_term(
+    b: &Stiffening,
+    sign: f64,
+    eps: &Vector3<f64>,
+    gradient: &mut Vector3<f64>,
+    hessian: &mut Matrix3<f64>,
+) -> f64 {
+    let mut value = 0.0;
+    // E11 = (I11 - 1)/2 and E22 = (I22 - 1)/2: dE/dI = 1/2.
+    for (index, strain, k) in [(0, eps[0], b.k_weft), (2, eps[1], b.k_warp)] {
+        let excess = (sign * strain - b.onset).max(0.0);
+        value += 0.5 * k * excess * excess;
+        gradient[index] += 0.5 * sign * k * excess;
+        if excess > 0.0 {
+            hessian[(index, index)] += 0.25 * k;
+        }
+    }
+    value
 }
 
 #[cfg(test)]
@@ -204,6 +237,7 @@ mod tests {
             k_n1: 0.2,
             k_n2: 0.1,
             stiffening: Some(Stiffening { k_weft: 5.0, k_warp: 2.0, onset: 0.1 }),
+            jamming: Some(Stiffening { k_weft: 4.0, k_warp: 3.0, onset: 0.02 }),
         };
         let rest = m.jet([1.0, 0.0, 1.0]);
         assert!(rest.value.abs() < 1e-15 && rest.gradient.norm() < 1e-15);
@@ -222,6 +256,37 @@ mod tests {
         }
     }
 
+    /// The transverse Green strain `E22` of zero transverse stress at `E11` (Newton on `I22`).
+    fn free_transverse_strain(m: &StvkNeoHookean, e11: f64) -> f64 {
+        let mut i22 = 1.0;
+        for _ in 0..50 {
+            let jet = m.jet([1.0 + 2.0 * e11, 0.0, i22]);
+            i22 -= jet.gradient[2] / jet.hessian[(2, 2)];
+        }
+        0.5 * (i22 - 1.0)
+    }
+
+    #[test]
+    fn jamming_stops_the_transverse_contraction_past_its_onset() {
+        let free = StvkNeoHookean {
+            k_xx: 2.0,
+            k_xy: 0.8,
+            k_yy: 1.0,
+            k_ss: 1.0,
+            k_n1: 0.0,
+            k_n2: 0.0,
+            stiffening: None,
+            jamming: None,
+        };
+        let jammed =
+            StvkNeoHookean { jamming: Some(Stiffening { k_weft: 0.0, k_warp: 100.0, onset: 0.05 }), ..free };
+        // Before the onset nothing changes; past it the contraction stops near the onset.
+        assert!((free_transverse_strain(&jammed, 0.05) - free_transverse_strain(&free, 0.05)).abs() < 1e-12);
+        assert!((free_transverse_strain(&free, 0.3) + 0.24).abs() < 1e-9);
+        let e22 = free_transverse_strain(&jammed, 0.3);
+        assert!(e22 < -0.05 && e22 > -0.052, "{e22}");
+    }
+
     #[test]
     fn the_area_term_resists_inversion() {
         // Uniaxial compression of an isotropic StVK sheet: the Neo-Hookean log term grows
@@ -234,6 +299,7 @@ mod tests {
             k_n1: 0.0,
             k_n2: 0.1,
             stiffening: None,
+            jamming: None,
         };
         let energy = |s: f64| m.jet([s * s, 0.0, 1.0]).value;
         assert!(energy(1e-3) > energy(0.1) && energy(0.1) > energy(0.5));

@@ -134,6 +134,7 @@ mod tests {
                 k_n1: 0.0,
                 k_n2: 0.0,
                 stiffening: None,
+                jamming: None,
             }),
             hinge_bending: None,
         };
