@@ -180,28 +180,28 @@ fn simulate_samples(
         march.push(sample);
     }
     let (c0, c1) = (march[0].compression, march[n - 1].compression);
-    let mut curve = SimulatedCurve {
-        direction,
-        stretch: s.clone(),
-        compression: Vec::with_capacity(n),
-        stress_n_m: Vec::with_capacity(n),
-        iterations,
-    };
-    let mut samples = Vec::with_capacity(n);
-    for (i, marched) in march.into_iter().enumerate() {
-        let sample = if i == 0 || i + 1 == n {
-            marched
-        } else {
+    // The stretches in between, at the interpolated compression: independent solves, in parallel.
+    let samples = march
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, marched)| {
+            if i == 0 || i + 1 == n {
+                return Ok((marched, 0));
+            }
             let w = interpolation_weight(s, i);
             let sample = solve_uniaxial(tile, direction, s[i], c0 + (c1 - c0) * w, Some(&marched.state))?;
-            curve.iterations += sample.iterations;
-            sample
-        };
-        curve.compression.push(sample.compression);
-        curve.stress_n_m.push(sample.stretch_stress_n_m);
-        samples.push(sample);
-    }
-    Ok((curve, samples))
+            let iterations = sample.iterations;
+            Ok((sample, iterations))
+        })
+        .collect::<Result<Vec<_>, TileError>>()?;
+    let curve = SimulatedCurve {
+        direction,
+        stretch: s.clone(),
+        compression: samples.iter().map(|(sample, _)| sample.compression).collect(),
+        stress_n_m: samples.iter().map(|(sample, _)| sample.stretch_stress_n_m).collect(),
+        iterations: iterations + samples.iter().map(|(_, it)| it).sum::<usize>(),
+    };
+    Ok((curve, samples.into_iter().map(|(sample, _)| sample).collect()))
 }
 
 /// The weight of the last stretch's compression in the interpolated compression at stretch `i`.
