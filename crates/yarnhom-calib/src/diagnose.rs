@@ -721,14 +721,6 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         None if bases_within_noise => (CauseId::None, None),
         None => (CauseId::Unexplained, None),
     };
-    evidence.push(match id {
-        CauseId::None => "no candidate passes the tests (held-out error below 75% of its base's, by more than 2 x noise, criterion lower by 4, at most half of the base's held-out error above the noise left), and every base's held-out error is within max(3 x noise, 0.03) of its track".to_string(),
-        CauseId::Unexplained => "no candidate passes the tests, and a base's held-out error exceeds max(3 x noise, 0.03) of its track".to_string(),
-        _ => format!(
-            "chosen: {} (lowest held-out error relative to its base among the candidates that pass the tests)",
-            id.as_str()
-        ),
-    });
     for c in significant.iter().filter(|c| excess_left(c) > MAX_EXCESS_LEFT) {
         evidence.push(format!(
             "{}: significant, but it leaves {:.0}% of its base's held-out error above the noise (more than {:.0}%): a partial explanation",
@@ -737,6 +729,14 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
             100.0 * MAX_EXCESS_LEFT
         ));
     }
+    evidence.push(match id {
+        CauseId::None => "no candidate passes the tests (held-out error below 75% of its base's, by more than 2 x noise, criterion lower by 4, at most half of the base's held-out error above the noise left), and every base's held-out error is within max(3 x noise, 0.03) of its track".to_string(),
+        CauseId::Unexplained => "no candidate passes the tests, and a base's held-out error exceeds max(3 x noise, 0.03) of its track".to_string(),
+        _ => format!(
+            "chosen: {} (lowest held-out error relative to its base among the candidates that pass the tests)",
+            id.as_str()
+        ),
+    });
     let also: Vec<&str> = passing.iter().map(|c| c.id.as_str()).filter(|c| *c != id.as_str()).collect();
     if !also.is_empty() {
         evidence.push(format!(
