@@ -50,8 +50,11 @@ fn truth_tile() -> (Pattern, RveModel, yarnhom_rve::assembly::RveState) {
 fn the_stretch_stress_is_the_energy_slope_and_the_compression_leaves_no_orthogonal_stress() {
     let (_, tile, rest) = truth_tile();
     for direction in [Direction::Weft, Direction::Bias, Direction::Warp] {
-        // Past the slack range of the generated stockinette (its yarns go taut near 30%).
-        let s = 0.45;
+        // Past the slack range of the generated stockinette (its yarns go taut near 30%). At
+        // 45% bias the tile is multistable near its zero of orthogonal stress (c ≈ 0.295: warm
+        // and cold solves differ by 7% in energy, and σ_c is not monotone in c on the warm
+        // branch), so the bias is taken at 50%, where the branch is smooth.
+        let s = if direction == Direction::Bias { 0.5 } else { 0.45 };
         let zero = zero_orthogonal_stress(&tile, direction, s, 0.0, Some(&rest)).expect("found");
         assert!(
             zero.compression_stress_n_m.abs() <= 1e-2 * zero.stretch_stress_n_m.abs().max(1.0),
@@ -125,14 +128,12 @@ fn the_hidden_model_has_no_residual_and_the_local_steps_move_towards_it() {
         outcomes.push((local, report, worst));
     }
     // The objective is not smooth (every evaluation re-estimates the rest shape), so no
-    // optimizer reaches zero; COBYLA and LM (whose finite differences go through the rest-shape
-    // estimation) must remove most of the misfit. Gauss-Newton's sensitivity Jacobian holds the
-    // rest shape, and each re-estimation moves the optimum it converged to: it must still
-    // halve the misfit (measured: 0.347 -> 0.165 in 8 Jacobians, 31 evaluations; COBYLA 0.115
-    // in 39; LM 0.061 in 43).
+    // optimizer reaches zero; each must remove most of the misfit (measured from 0.476:
+    // Gauss-Newton with the sensitivity Jacobian 0.027 in 43 evaluations, COBYLA 0.088 in 41,
+    // LM with finite differences through the rest-shape estimation 0.066 in 26).
     for (local, report, worst) in &outcomes {
         eprintln!("{local:?}: {report:?}, worst comfort stress error {worst:.4}");
-        let bound = if *local == LocalSolver::GaussNewton { 0.6 } else { 0.35 };
+        let bound = 0.35;
         assert!(
             report.cost < bound * report.start_cost,
             "{local:?}: {report:?} (worst comfort error {worst})"

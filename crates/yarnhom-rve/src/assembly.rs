@@ -280,14 +280,15 @@ pub fn assemble_with(
         let reference = bend_reference(placement, state, b, k);
         let q = bend_dofs(model, placement, g, b);
         let twists = [b.prev.vertex, b.vertex.vertex];
-        if derivatives {
+        if want != Want::Energy {
             let (e, grad, hess) = b.element.energy_gradient_hessian(&reference, &q);
             out.energy_j += e;
+            let h = derivatives.then_some(hess.as_slice());
             Scatter { model, placement, out: &mut out, lower }.add(
                 &[b.prev, b.vertex, b.next],
                 &twists,
                 grad.as_slice(),
-                Some(hess.as_slice()),
+                h,
             );
         } else {
             out.energy_j += b.element.energy(&reference, &q);
