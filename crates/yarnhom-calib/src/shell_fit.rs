@@ -521,15 +521,20 @@ impl Problem {
         prior: &[f64],
         lm: &LmSettings,
     ) -> Option<LmReport> {
-        let residuals = |p: &[f64]| {
-            let per_direction = self.simulate(&parameterization.decode(p))?;
-            let r = self.data.iter().zip(&per_direction).flat_map(|(d, r)| {
-                let (f, c) = forces_and_compressions(r);
-                d.residuals(&f, &c, true)
-            });
-            Some(Self::with_prior(p, prior, r.collect()))
-        };
+        let residuals =
+            |p: &[f64]| Some(Self::with_prior(p, prior, self.fitted_residuals(&parameterization.decode(p))?));
         minimize(residuals, start, lm)
+    }
+
+    /// (6.2)'s weighted residuals of the fitted targets with the clamped swatches of `m`
+    /// simulated (`None` without equilibrium).
+    pub fn fitted_residuals(&self, m: &StvkNeoHookean) -> Option<Vec<f64>> {
+        let per_direction = self.simulate(m)?;
+        let r = self.data.iter().zip(&per_direction).flat_map(|(d, r)| {
+            let (f, c) = forces_and_compressions(r);
+            d.residuals(&f, &c, true)
+        });
+        Some(r.collect())
     }
 }
 
@@ -606,12 +611,8 @@ pub(crate) fn fit_membrane(
     let screened = problem.screen(&parameterization, &prior, lm);
     let screening = parameterization.decode(&screened);
     let cost = |p: &[f64]| {
-        let readings = problem.simulate(&parameterization.decode(p))?;
-        let r = problem.data.iter().zip(&readings).flat_map(|(d, r)| {
-            let (f, c) = forces_and_compressions(r);
-            d.residuals(&f, &c, true)
-        });
-        Some(r.map(|x| x * x).sum::<f64>())
+        let r = problem.fitted_residuals(&parameterization.decode(p))?;
+        Some(r.iter().map(|x| x * x).sum::<f64>())
     };
     let from = [screened, prior.clone()]
         .into_iter()
