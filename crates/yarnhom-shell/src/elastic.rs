@@ -47,23 +47,41 @@ impl Assembly {
             }
         }
     }
+}
 
-    /// Add an element's energy, gradient and Hessian over the vertices `vertices` (absent
-    /// vertices contribute nothing).
-    pub fn add_element<const N: usize>(
+/// Where [`ElasticModel::assemble`] puts the elements it evaluates, in the model's element order
+/// (see [`ElasticModel::element_vertices`]).
+pub trait ElementSink {
+    /// Take element `index`: its energy, gradient and (if asked for) Hessian over `vertices`
+    /// (absent vertices contribute nothing).
+    fn add<const N: usize>(
         &mut self,
+        index: usize,
         vertices: &[Option<u32>],
         energy: f64,
         gradient: &SVector<f64, N>,
-        hessian: Option<&SMatrix<f64, N, N>>,
+        hessian: Option<&SplitHessian<N>>,
+    );
+}
+
+impl ElementSink for Assembly {
+    /// The energy, gradient and clamped Hessian as triplets.
+    fn add<const N: usize>(
+        &mut self,
+        _index: usize,
+        vertices: &[Option<u32>],
+        energy: f64,
+        gradient: &SVector<f64, N>,
+        hessian: Option<&SplitHessian<N>>,
     ) {
         self.energy += energy;
+        let clamped = hessian.map(SplitHessian::clamped);
         for (a, va) in vertices.iter().enumerate() {
             let Some(va) = va else { continue };
             for k in 0..3 {
                 self.gradient[3 * *va as usize + k] += gradient[3 * a + k];
             }
-            let Some(h) = hessian else { continue };
+            let Some(h) = &clamped else { continue };
             for (b, vb) in vertices.iter().enumerate() {
                 let Some(vb) = vb else { continue };
                 for k in 0..3 {
@@ -79,6 +97,28 @@ impl Assembly {
     }
 }
 
+/// A symmetric element Hessian `H` with its negative eigenvalue part `N = Σ_{λ<0} λ v vᵀ`
+/// (`None` when `H` is positive semidefinite): the clamped Hessian `H - N` drops the negative
+/// curvature, the absolute one `H - 2N` flips its sign (Chen et al. 2024, "Trust-region
+/// eigenvalue filtering for projected Newton"); both are positive semidefinite.
+#[derive(Debug, Clone)]
+pub struct SplitHessian<const N: usize> {
+    /// The exact Hessian.
+    pub exact: SMatrix<f64, N, N>,
+    /// Its negative eigenvalue part, if any.
+    pub negative: Option<SMatrix<f64, N, N>>,
+}
+
+impl<const N: usize> SplitHessian<N> {
+    /// `H` with its negative eigenvalues set to zero.
+    pub fn clamped(&self) -> SMatrix<f64, N, N> {
+        match &self.negative {
+            Some(n) => self.exact - n,
+            None => self.exact,
+        }
+    }
+}
+
 /// Whether a symmetric matrix is positive semidefinite up to rounding: a Cholesky
 /// factorization of `H + ε I` (`ε` at rounding level) succeeds.
 fn is_psd<const N: usize>(h: &SMatrix<f64, N, N>) -> bool {
@@ -86,24 +126,29 @@ fn is_psd<const N: usize>(h: &SMatrix<f64, N, N>) -> bool {
     nalgebra::Cholesky::new(h + SMatrix::<f64, N, N>::identity() * (1e-12 * scale)).is_some()
 }
 
-macro_rules! psd_projection {
+macro_rules! split_hessian {
     ($name:ident, $n:literal) => {
-        /// Clamp the eigenvalues of a symmetric element Hessian to be non-negative; matrices that
-        /// are already positive semidefinite are returned untouched, skipping the eigensolver.
-        pub fn $name(h: SMatrix<f64, $n, $n>) -> SMatrix<f64, $n, $n> {
+        /// `h` with its negative eigenvalue part; matrices that are already positive
+        /// semidefinite skip the eigensolver.
+        pub fn $name(h: SMatrix<f64, $n, $n>) -> SplitHessian<$n> {
             if is_psd(&h) {
-                return h;
+                return SplitHessian { exact: h, negative: None };
             }
-            let mut eigen = nalgebra::SymmetricEigen::new(h);
-            eigen.eigenvalues.iter_mut().for_each(|l| *l = l.max(0.0));
-            eigen.recompose()
+            let eigen = nalgebra::SymmetricEigen::new(h);
+            let mut negative = SMatrix::<f64, $n, $n>::zeros();
+            for (l, v) in eigen.eigenvalues.iter().zip(eigen.eigenvectors.column_iter()) {
+                if *l < 0.0 {
+                    negative += *l * v * v.transpose();
+                }
+            }
+            SplitHessian { exact: h, negative: Some(negative) }
         }
     };
 }
 
-psd_projection!(project_psd_9, 9);
-psd_projection!(project_psd_12, 12);
-psd_projection!(project_psd_18, 18);
+split_hessian!(split_hessian_9, 9);
+split_hessian!(split_hessian_12, 12);
+split_hessian!(split_hessian_18, 18);
 
 /// A cloth's elastic energy: mesh, rest data and material.
 #[derive(Debug, Clone)]
@@ -118,6 +163,29 @@ pub struct ElasticModel {
 
 /// An element's energy, gradient and Hessian (if asked for).
 pub type Element<const N: usize> = (f64, SVector<f64, N>, Option<SMatrix<f64, N, N>>);
+
+/// An element's energy, gradient and Hessian with its negative part (if asked for).
+type SplitElement<const N: usize> = (f64, SVector<f64, N>, Option<SplitHessian<N>>);
+
+/// Elements evaluated in parallel per chunk, then handed on in order: a chunk's results stay
+/// small (about 1 MB for 18-DOF elements) where all of a mesh's would take tens of MB.
+const CHUNK: usize = 256;
+
+/// Evaluate the elements `0..count` (`element` gives each one's vertices and values) and hand
+/// them to `out` in order, element `k` as index `first_index + k`.
+fn hand_on<const N: usize, const V: usize>(
+    count: usize,
+    first_index: usize,
+    out: &mut impl ElementSink,
+    element: impl Fn(usize) -> ([Option<u32>; V], SplitElement<N>) + Sync,
+) {
+    for start in (0..count).step_by(CHUNK) {
+        let chunk: Vec<_> = (start..(start + CHUNK).min(count)).into_par_iter().map(&element).collect();
+        for (k, (vertices, (e, g, h))) in chunk.iter().enumerate() {
+            out.add(first_index + start + k, vertices, *e, g, h.as_ref());
+        }
+    }
+}
 
 impl ElasticModel {
     /// The model of `mesh` made of `material`, rest state flat at the material coordinates.
@@ -193,40 +261,40 @@ impl ElasticModel {
         triangles + hinges
     }
 
-    /// Energy, gradient and, if `hessian`, the clamped Hessian, added into `out`. Elements are
-    /// evaluated in parallel and summed in element order (identical for any thread count).
-    pub fn assemble(&self, x: &[Vector3<f64>], hessian: bool, out: &mut Assembly) {
-        let count = self.rest.len();
+    /// The vertices of every element in the order [`ElasticModel::assemble`] hands them on:
+    /// the triangles (their stencils, or only their corners for a membrane material), then the
+    /// hinges.
+    pub fn element_vertices(&self) -> Vec<Vec<Option<u32>>> {
+        let triangles = (0..self.rest.len()).map(|t| match self.material.uses_second_form() {
+            true => self.stencil_vertices(t).to_vec(),
+            false => self.mesh.triangles[t].map(Some).to_vec(),
+        });
+        let hinges = self.mesh.hinges.iter().take(self.hinges.len()).map(|h| h.vertices.map(Some).to_vec());
+        triangles.chain(hinges).collect()
+    }
+
+    /// Energy, gradient and, if `hessian`, the element Hessians with their negative parts, handed
+    /// to `out` in element order. Elements are evaluated in parallel, in chunks, and handed on in
+    /// order (identical for any thread count).
+    pub fn assemble(&self, x: &[Vector3<f64>], hessian: bool, out: &mut impl ElementSink) {
+        let triangles = self.rest.len();
         if self.material.uses_second_form() {
-            let triangles: Vec<Element<18>> =
-                (0..count).into_par_iter().map(|t| self.triangle_element(t, x, hessian)).collect();
-            for (t, (e, g, h)) in triangles.iter().enumerate() {
-                out.add_element(&self.stencil_vertices(t), *e, g, h.as_ref());
-            }
+            hand_on(triangles, 0, out, |t| (self.stencil_vertices(t), self.triangle_element(t, x, hessian)));
         } else {
-            let triangles: Vec<Element<9>> =
-                (0..count).into_par_iter().map(|t| self.membrane_element(t, x, hessian)).collect();
-            for (t, (e, g, h)) in triangles.iter().enumerate() {
-                out.add_element(&self.mesh.triangles[t].map(Some), *e, g, h.as_ref());
-            }
+            hand_on(triangles, 0, out, |t| {
+                (self.mesh.triangles[t].map(Some), self.membrane_element(t, x, hessian))
+            });
         }
-        let hinges: Vec<Element<12>> = self
-            .hinges
-            .par_iter()
-            .zip(&self.mesh.hinges)
-            .map(|(rest, h)| {
-                let d = hinge_energy_with_derivatives(rest, &h.vertices.map(|v| x[v as usize]));
-                (d.energy, d.gradient, hessian.then(|| project_psd_12(d.hessian)))
-            })
-            .collect();
-        for ((e, g, h), hinge) in hinges.iter().zip(&self.mesh.hinges) {
-            out.add_element(&hinge.vertices.map(Some), *e, g, h.as_ref());
-        }
+        hand_on(self.hinges.len(), triangles, out, |k| {
+            let vertices = self.mesh.hinges[k].vertices;
+            let d = hinge_energy_with_derivatives(&self.hinges[k], &vertices.map(|v| x[v as usize]));
+            (vertices.map(Some), (d.energy, d.gradient, hessian.then(|| split_hessian_12(d.hessian))))
+        });
     }
 
     /// (4.8) for a membrane material (`Ψ(I)` only) over the triangle's 9 DOFs:
-    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂I_k ∇² I_k)`, clamped to PSD.
-    fn membrane_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> Element<9> {
+    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂I_k ∇² I_k)`, with its negative part.
+    fn membrane_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> SplitElement<9> {
         let rest = &self.rest[t];
         let forms = first_form_with_derivatives(rest, &self.mesh.triangles[t].map(|v| x[v as usize]));
         let jet = self.material.jet(forms.first, [0.0; 3]);
@@ -238,15 +306,15 @@ impl ElasticModel {
             for (k, d2i) in forms.hessian.iter().enumerate() {
                 h += dpsi[k] * d2i;
             }
-            project_psd_9(area * h)
+            split_hessian_9(area * h)
         });
         (area * jet.value, gradient, h)
     }
 
-    /// (4.8) with (A.43)-(A.44), the Hessian clamped to PSD.
-    fn triangle_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> Element<18> {
+    /// (4.8) with (A.43)-(A.44), the Hessian with its negative part.
+    fn triangle_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> SplitElement<18> {
         let (e, g, h) = self.triangle_element_exact(t, x, hessian);
-        (e, g, h.map(project_psd_18))
+        (e, g, h.map(split_hessian_18))
     }
 
     /// (4.8) with (A.43)-(A.44): `E = A Ψ(z(q))`, `∇E = A Jᵀ ∇Ψ`,
@@ -342,7 +410,7 @@ mod tests {
         for t in 0..mesh.triangles.len() {
             let (e18, g18, h18) = model.triangle_element_exact(t, &x, true);
             let (e9, g9, h9) = model.membrane_element(t, &x, true);
-            let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for"));
+            let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for").exact);
             assert!((e18 - e9).abs() < 1e-15 * e18.abs().max(1.0));
             assert!((g18.fixed_rows::<9>(0) - g9).amax() < 1e-12 * g9.amax().max(1.0));
             assert!(g18.fixed_rows::<9>(9).amax() == 0.0);
@@ -376,11 +444,12 @@ mod tests {
         a[(1, 1)] = -1.0;
         a[(0, 1)] = 0.5;
         a[(1, 0)] = 0.5;
-        let p = project_psd_12(a);
+        let split = split_hessian_12(a);
+        let p = split.clamped();
         assert!(p.symmetric_eigenvalues().iter().all(|&l| l >= -1e-14));
         assert!((p[(5, 5)] - 1.0).abs() < 1e-14 && p[(1, 1)] > -1.0);
         let spd = SMatrix::<f64, 18, 18>::identity() * 2.0;
-        assert_eq!(project_psd_18(spd), spd);
+        assert!(split_hessian_18(spd).negative.is_none());
     }
 
     #[test]

@@ -8,18 +8,19 @@
 //! per-element PSD-clamped Hessians; Rayleigh damping `D = α M + β K_n` (`K_n` the clamped
 //! elastic Hessian at the start of the step) enters as `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
 //! Handle vertices follow their scripted positions and are removed from the unknowns. The
-//! Newton systems are solved by faer's sparse Cholesky on a symbolic analysis computed once
-//! (the pattern is that of the mesh stencils). Friction against obstacles is applied to the
+//! Newton matrices are assembled straight into one sparsity pattern (the mesh's element
+//! couplings and vertex blocks) and solved by faer's sparse Cholesky on its symbolic analysis,
+//! both computed once ([`crate::pattern`]). Friction against obstacles is applied to the
 //! new velocities ([`crate::contact`]).
 
 use std::time::Instant;
 
 use nalgebra::{Matrix3, Vector3};
-use yarnhom_rve::linear::SpdSolver;
 
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
 use crate::elastic::{Assembly, ElasticModel};
 use crate::line_search::backtrack;
+use crate::pattern::{HessianPattern, NewtonAssembly};
 
 /// A piecewise linear translation over time (keyframes `(time_s, translation_m)`), constant
 /// before the first and after the last key.
@@ -123,15 +124,17 @@ pub struct Simulation {
     contact: ContactSettings,
     self_collision: Option<SelfCollision>,
     dynamics: Dynamics,
-    solver: SpdSolver,
+    pattern: HessianPattern,
+    /// The slots of the Newton matrix in the rows and columns of the fixed DOFs.
+    pinned: Vec<usize>,
 }
 
 /// The parts of `Φ` that do not change within a step.
 struct StepTerms {
     predicted: Vec<Vector3<f64>>,
     start: Vec<Vector3<f64>>,
-    /// `β K_n` as lower triplets (empty without stiffness damping).
-    stiffness_damping: Vec<(usize, usize, f64)>,
+    /// `β K_n` on the pattern (empty without stiffness damping).
+    stiffness_damping: Vec<f64>,
 }
 
 impl Simulation {
@@ -153,6 +156,8 @@ impl Simulation {
         let handle_origins =
             handles.iter().map(|h| h.vertices.iter().map(|&v| positions[v]).collect()).collect();
         let self_collision = SelfCollision::new(&contact, &model.mesh.material);
+        let pattern = HessianPattern::new(positions.len(), &model.element_vertices());
+        let pinned = pattern.slots_touching(&fixed);
         Self {
             velocities: vec![Vector3::zeros(); positions.len()],
             positions,
@@ -165,7 +170,8 @@ impl Simulation {
             contact,
             self_collision,
             dynamics,
-            solver: SpdSolver::default(),
+            pattern,
+            pinned,
             model,
         }
     }
@@ -220,20 +226,20 @@ impl Simulation {
             converged: false,
             wall_time_s: 0.0,
         };
-        // One buffer for every iteration's assembly (about a million Hessian entries on a
-        // 2500-vertex cloth), so its memory is allocated once per step.
-        let mut a = Assembly::new(3 * x.len());
+        // One buffer for every iteration's assembly, so its memory is allocated once per step.
+        let mut a = NewtonAssembly::new(&self.pattern);
         // Φ at the current iterate, when the last line search computed it.
         let mut phi: Option<f64> = None;
         for iteration in 0..self.dynamics.max_newton_iterations {
             self.assemble(&x, &mut terms, iteration == 0, &mut a);
-            a.pin(&self.fixed);
+            self.pin(&mut a);
             stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
-            self.solver
-                .factor(3 * x.len(), &a.triplets, 0.0)
+            let factor = self
+                .pattern
+                .factor(&a.matrix)
                 .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
-            self.solver.solve_in_place(&mut dx, 1);
+            factor.solve_in_place(&mut dx);
             let phi0 = phi.unwrap_or_else(|| self.potential(&x, &terms));
             let slope = dot(&a.gradient, &dx);
             let (alpha, halvings, accepted) =
@@ -310,20 +316,31 @@ impl Simulation {
         }
         if !terms.stiffness_damping.is_empty() {
             let d = flatten_difference(x, &terms.start);
-            phi += 0.5 * dot(&d, &symmetric_product(&terms.stiffness_damping, &d)) / h;
+            phi += 0.5 * dot(&d, &self.pattern.symmetric_product(&terms.stiffness_damping, &d)) / h;
         }
         phi
     }
 
+    /// Hold the fixed DOFs: zero gradient, identity rows and columns in the Newton matrix.
+    fn pin(&self, a: &mut NewtonAssembly) {
+        for &slot in &self.pinned {
+            a.matrix[slot] = 0.0;
+        }
+        for (dof, _) in self.fixed.iter().enumerate().filter(|(_, f)| **f) {
+            a.gradient[dof] = 0.0;
+            a.matrix[self.pattern.diagonal_slot(dof)] = 1.0;
+        }
+    }
+
     /// Gradient and Newton matrix of `Φ`. On the step's first iteration the clamped elastic
     /// Hessian is also kept, scaled by `β`, as the stiffness damping matrix `β K_n`.
-    fn assemble(&self, x: &[Vector3<f64>], terms: &mut StepTerms, first: bool, a: &mut Assembly) {
+    fn assemble(&self, x: &[Vector3<f64>], terms: &mut StepTerms, first: bool, a: &mut NewtonAssembly) {
         let h = self.dynamics.dt_s;
-        a.clear();
-        self.model.assemble(x, true, a);
         let beta = self.dynamics.stiffness_damping;
-        if first && beta > 0.0 {
-            terms.stiffness_damping = a.triplets.iter().map(|&(i, j, v)| (i, j, beta * v)).collect();
+        a.clear(first && beta > 0.0);
+        self.model.assemble(x, true, a);
+        if let Some(clamped) = a.clamped.take() {
+            terms.stiffness_damping = clamped.iter().map(|v| beta * v).collect();
         }
         let g = Vector3::from(self.dynamics.gravity);
         let alpha = self.dynamics.mass_damping;
@@ -333,7 +350,7 @@ impl Simulation {
             let diagonal = m / (h * h) + alpha * m / h;
             for k in 0..3 {
                 a.gradient[3 * i + k] += force[k];
-                a.triplets.push((3 * i + k, 3 * i + k, diagonal));
+                a.matrix[self.pattern.diagonal_slot(3 * i + k)] += diagonal;
             }
         }
         let mut blocks: Vec<(usize, Matrix3<f64>)> = Vec::new();
@@ -349,7 +366,7 @@ impl Simulation {
         for (v, block) in blocks {
             for k in 0..3 {
                 for l in 0..=k {
-                    a.triplets.push((3 * v + k, 3 * v + l, block[(k, l)]));
+                    a.matrix[self.pattern.vertex_block_slot(v, k, l)] += block[(k, l)];
                 }
             }
         }
@@ -359,13 +376,16 @@ impl Simulation {
     }
 
     /// `β K_n (x - x_n) / h` into the gradient and `β K_n / h` into the matrix.
-    fn add_damping(&self, x: &[Vector3<f64>], terms: &StepTerms, a: &mut Assembly) {
+    fn add_damping(&self, x: &[Vector3<f64>], terms: &StepTerms, a: &mut NewtonAssembly) {
         let h = self.dynamics.dt_s;
         let d = flatten_difference(x, &terms.start);
-        for (g, kd) in a.gradient.iter_mut().zip(symmetric_product(&terms.stiffness_damping, &d)) {
+        for (g, kd) in a.gradient.iter_mut().zip(self.pattern.symmetric_product(&terms.stiffness_damping, &d))
+        {
             *g += kd / h;
         }
-        a.triplets.extend(terms.stiffness_damping.iter().map(|&(i, j, v)| (i, j, v / h)));
+        for (m, k) in a.matrix.iter_mut().zip(&terms.stiffness_damping) {
+            *m += k / h;
+        }
     }
 }
 
@@ -375,18 +395,6 @@ fn flatten_difference(x: &[Vector3<f64>], y: &[Vector3<f64>]) -> Vec<f64> {
 
 fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
-/// `A v` for a symmetric `A` given by its lower-triangle triplets.
-fn symmetric_product(lower: &[(usize, usize, f64)], v: &[f64]) -> Vec<f64> {
-    let mut out = vec![0.0; v.len()];
-    for &(i, j, a) in lower {
-        out[i] += a * v[j];
-        if i != j {
-            out[j] += a * v[i];
-        }
-    }
-    out
 }
 
 #[cfg(test)]

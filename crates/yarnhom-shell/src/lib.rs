@@ -8,7 +8,8 @@
 //! - [`contact`]: obstacles, friction and self-collision.
 //! - [`scene`], [`arcsim_scene`]: scene files, built-ins and the published ARCSim scenes.
 //! - [`simulate`]: running a scene frame by frame.
-//! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping.
+//! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping;
+//!   its Newton matrices on one sparsity pattern (`pattern`).
 //! - [`statics`]: static equilibrium with held DOFs (clamped swatch tests).
 
 pub mod arcsim_scene;
@@ -21,6 +22,7 @@ pub mod integrator;
 mod line_search;
 pub mod material;
 pub mod mesh;
+mod pattern;
 pub mod scene;
 pub mod simulate;
 pub mod statics;
