@@ -56,7 +56,8 @@ pub enum YarnMechanics {
         k_c1_n_m: f64,
         /// Inner (stiff) contact radius R_2 (m).
         r2_m: f64,
-        /// Inner contact stiffness k_c2 (N/m).
+        /// Inner contact stiffness k_c2 (N/m); 0 leaves only the outer barrier (single-phase
+        /// contact).
         k_c2_n_m: f64,
     },
 }
@@ -132,7 +133,8 @@ impl YarnModel {
     pub fn validate(&self) -> Result<(), ValidationError> {
         for (name, value) in self.parameters() {
             match name {
-                "eps_bar" => check::non_negative(name, value)?,
+                // eps_bar = 0: stiff from the start; k_c2 = 0: single-phase contact.
+                "eps_bar" | "k_c2_n_m" => check::non_negative(name, value)?,
                 _ => check::positive(name, value)?,
             }
         }

@@ -32,6 +32,10 @@
 //!    with the lowest held-out error relative to its base is the cause. Without one, the cause
 //!    is `none` when every track's base held-out error is within `max(3 x noise, 3%)`, else
 //!    `unexplained`.
+//! 5. Confirmation (separate, [`crate::yarn_confirm`], run by `calibrate diagnose` unless
+//!    `--budget quick`): a cause with a mechanism in the yarn model is confirmed on the
+//!    periodic tile by nested yarn-level fits to the extended shell's uniform targets
+//!    ([`Diagnosis::extended_material`]); the result goes to [`Diagnosis::yarn_level`].
 //!
 //! Errors are RMS values of the normalized residuals of (6.2) (force over the direction's mean
 //! force, compression over its mean compression), pooled over the fitted or the held-out
@@ -57,6 +61,7 @@ use crate::shell_fit::{
 };
 use crate::swatch::SimulatedReading;
 use crate::targets::{Target, TargetPlan, targets};
+use crate::yarn_confirm::YarnLevel;
 
 /// The catalog of causes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
@@ -261,6 +266,15 @@ pub struct Diagnosis {
     /// The bending track, when the set has bending tests.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub bending: Option<BendingTrack>,
+    /// The fitted membrane of the chosen stretch-track extension (absent for `none`,
+    /// `unexplained` and the bending causes): a material to simulate, and the source of the
+    /// yarn-level confirmation's targets.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub extended_material: Option<StvkNeoHookean>,
+    /// The yarn-level confirmation of the cause ([`crate::yarn_confirm`]); absent until it is
+    /// run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yarn_level: Option<YarnLevel>,
     /// Wall time (s).
     pub wall_time_s: f64,
 }
@@ -284,8 +298,8 @@ pub struct BendingTrack {
 
 /// Format tag of [`Diagnosis`] files.
 pub const DIAGNOSIS_FORMAT: &str = "yarnhom.diagnosis";
-/// Layout version of [`Diagnosis`] files.
-pub const DIAGNOSIS_VERSION: u32 = 2;
+/// Layout version of [`Diagnosis`] files (v3 adds `extended_material` and `yarn_level`).
+pub const DIAGNOSIS_VERSION: u32 = 3;
 
 /// The JSON Schema of `report.json`.
 pub fn diagnosis_schema() -> schemars::Schema {
@@ -753,7 +767,8 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         t.predictions.push((cid.as_str().into(), f.simulated.clone()));
     }
     let mut predictions = vec![base_fit.prediction("base")];
-    if let Some((cid, f)) = fits.iter().find(|(c, _)| *c == id) {
+    let chosen = fits.iter().find(|(c, _)| *c == id);
+    if let Some((cid, f)) = chosen {
         predictions.push(f.prediction(cid.as_str()));
     }
     let load_fitted = phases.load.data.iter().flat_map(|d| d.fitted.iter().copied()).collect();
@@ -776,6 +791,8 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
         load_fitted,
         predictions,
         bending: bending_track,
+        extended_material: chosen.map(|(_, f)| f.material),
+        yarn_level: None,
         wall_time_s: started.elapsed().as_secs_f64(),
     })
 }

@@ -23,6 +23,7 @@ pub mod targets;
 #[cfg(test)]
 mod test_support;
 pub mod uniform;
+pub mod yarn_confirm;
 pub mod yarn_fit;
 pub mod yarn_objective;
 pub mod yarn_params;

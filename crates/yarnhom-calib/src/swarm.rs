@@ -74,12 +74,14 @@ impl Uniform {
     }
 }
 
-/// Minimize `cost` over the box `bounds`; `None` costs are failures. `progress` sees the
-/// generation and the best cost after it.
+/// Minimize `cost` over the box `bounds`; `None` costs are failures. The first particles start
+/// at `seeds` (points in the box, e.g. a nested model's optimum; at most one per particle), the
+/// others at random. `progress` sees the generation and the best cost after it.
 pub fn minimize<F>(
     cost: F,
     bounds: &[(f64, f64)],
     settings: &SwarmSettings,
+    seeds: &[Vec<f64>],
     progress: &(dyn Fn(usize, f64) + Sync),
 ) -> SwarmReport
 where
@@ -91,6 +93,9 @@ where
         |u: &[f64]| -> Vec<f64> { u.iter().zip(bounds).map(|(x, (lo, hi))| lo + x * (hi - lo)).collect() };
     let mut position: Vec<Vec<f64>> =
         (0..settings.particles).map(|_| (0..dim).map(|_| random.next()).collect()).collect();
+    for (p, seed) in position.iter_mut().zip(seeds) {
+        *p = seed.iter().zip(bounds).map(|(x, (lo, hi))| ((x - lo) / (hi - lo)).clamp(0.0, 1.0)).collect();
+    }
     let mut velocity: Vec<Vec<f64>> =
         (0..settings.particles).map(|_| (0..dim).map(|_| 0.2 * (random.next() - 0.5)).collect()).collect();
     let evaluate = |points: &[Vec<f64>]| -> Vec<f64> {
@@ -189,7 +194,7 @@ mod tests {
             Some(x.iter().map(|v| v * v - 10.0 * (2.0 * std::f64::consts::PI * v).cos() + 10.0).sum::<f64>())
         };
         let settings = SwarmSettings { particles: 64, generations: 40, ..SwarmSettings::default() };
-        let report = minimize(rastrigin, &[(-5.0, 5.0); 2], &settings, &|_, _| {});
+        let report = minimize(rastrigin, &[(-5.0, 5.0); 2], &settings, &[], &|_, _| {});
         assert!(report.best_cost < 0.5, "{report:?}");
         assert_eq!(report.evaluations, 64 * 41);
         assert!(report.history.windows(2).all(|w| w[1] <= w[0]), "the best never gets worse");
@@ -198,7 +203,7 @@ mod tests {
     #[test]
     fn failed_evaluations_are_counted_and_avoided() {
         let cost = |x: &[f64]| if x[0] < 0.0 { None } else { Some((x[0] - 0.5).powi(2)) };
-        let report = minimize(cost, &[(-1.0, 1.0)], &SwarmSettings::default(), &|_, _| {});
+        let report = minimize(cost, &[(-1.0, 1.0)], &SwarmSettings::default(), &[], &|_, _| {});
         assert!(report.failures > 0);
         assert!((report.best[0] - 0.5).abs() < 0.05, "{report:?}");
     }

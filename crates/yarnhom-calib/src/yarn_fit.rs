@@ -110,6 +110,9 @@ pub enum YarnFitError {
     /// The shell fit has no measured direction.
     #[error("the shell fit has no measured direction to fit")]
     NoTargets,
+    /// The cause has no mechanism in the yarn model.
+    #[error("no yarn-level mechanism: {0}")]
+    NoMechanism(String),
     /// No parameter set could be evaluated.
     #[error("no parameter set of the swarm could be evaluated ({0} tried)")]
     NothingEvaluable(usize),
@@ -120,9 +123,9 @@ pub enum YarnFitError {
 pub enum TargetSource {
     /// The uniform tests of a fitted shell (6.3): the thesis' route from measurements.
     Shell(StvkNeoHookean),
-    /// The tile itself at a known search point: a ground truth that the estimation must
+    /// The tile itself with known parameters: a ground truth that the estimation must
     /// recover (identifiability and optimizer checks).
-    Yarn(Vec<f64>),
+    Yarn(YarnParams),
 }
 
 /// The estimation problem: the input geometry, the fixed quantities, and the uniform targets
@@ -210,7 +213,8 @@ impl YarnProblem {
                         comfort_compression: 0.0,
                     })
                     .collect();
-                let curves = self.evaluate(truth, &stretches)?.curves;
+                let rest_pattern = self.rest_shape_of(&self.yarn_model(truth))?;
+                let curves = self.evaluate_params(&rest_pattern, truth, &stretches)?.0.curves;
                 Ok(curves
                     .iter()
                     .zip(&self.directions)
@@ -220,10 +224,21 @@ impl YarnProblem {
         }
     }
 
+    /// `n` held-out targets per tested direction: the midpoints between those of
+    /// [`YarnProblem::targets`]`(n)`.
+    pub fn heldout_targets(&self, n: usize) -> Result<Vec<DirectionTargets>, YarnFitError> {
+        Ok(self.targets(2 * n)?.iter().map(|t| t.subset(|i| i.is_multiple_of(2))).collect())
+    }
+
     /// The yarn model at search point `x`.
     pub fn model(&self, x: &[f64]) -> (YarnParams, YarnModel) {
         let params = self.basis.params(x);
-        (params, params.model(&format!("{} (estimated)", self.pattern.name), &self.basis))
+        (params, self.yarn_model(&params))
+    }
+
+    /// The yarn model of `params`.
+    fn yarn_model(&self, params: &YarnParams) -> YarnModel {
+        params.model(&format!("{} (estimated)", self.pattern.name), &self.basis)
     }
 
     /// Estimate the rest shape for the parameters at `x`, then simulate the tile at `targets`.
@@ -234,12 +249,17 @@ impl YarnProblem {
 
     /// The rest shape estimated for the parameters at `x` (Sec. 6.5.2).
     pub fn rest_shape(&self, x: &[f64]) -> Result<Pattern, YarnFitError> {
+        self.rest_shape_of(&self.model(x).1)
+    }
+
+    /// The rest shape estimated for `model` (Sec. 6.5.2).
+    fn rest_shape_of(&self, model: &YarnModel) -> Result<Pattern, YarnFitError> {
         let options = RelaxOptions {
             method: RelaxMethod::Estimation { max_length_change: self.rest.max_length_change },
             max_resets: self.rest.max_resets,
             ..RelaxOptions::default()
         };
-        let (rest_pattern, _) = relax(&self.pattern, &self.model(x).1, &options, &mut |_| {})
+        let (rest_pattern, _) = relax(&self.pattern, model, &options, &mut |_| {})
             .map_err(|e| YarnFitError::RestShape(e.to_string()))?;
         Ok(rest_pattern)
     }
@@ -299,7 +319,17 @@ impl YarnProblem {
         x: &[f64],
         targets: &[DirectionTargets],
     ) -> Result<(Evaluation, RveModel, RveState), YarnFitError> {
-        let (params, model) = self.model(x);
+        self.evaluate_params(rest_pattern, &self.basis.params(x), targets)
+    }
+
+    /// [`YarnProblem::evaluate_on`] at the parameters `params`.
+    fn evaluate_params(
+        &self,
+        rest_pattern: &Pattern,
+        params: &YarnParams,
+        targets: &[DirectionTargets],
+    ) -> Result<(Evaluation, RveModel, RveState), YarnFitError> {
+        let (params, model) = (*params, self.yarn_model(params));
         let tile = RveModel::new(rest_pattern, &model).map_err(|e| YarnFitError::RestShape(e.to_string()))?;
         let zero = MacroStrain::new(0.0, 0.0, 0.0, 0.0, 0.0).expect("zero strain is valid");
         let (report, rest) = solve_at(&tile, &zero, None, &SolveOptions::default());
@@ -384,8 +414,9 @@ pub struct YarnFit {
 /// Format tag of [`YarnFit`] files.
 pub const YARN_FIT_FORMAT: &str = "yarnhom.yarn-fit";
 
-/// Layout version of [`YarnFit`] files (`schemas/yarn-fit.v1.schema.json`).
-pub const YARN_FIT_VERSION: u32 = 1;
+/// Layout version of [`YarnFit`] files (`schemas/yarn-fit.v2.schema.json`; v2 adds
+/// `basis.mechanisms`, and v1 files read as the thesis' mechanisms).
+pub const YARN_FIT_VERSION: u32 = 2;
 
 /// The JSON schema of [`YarnFit`] files.
 pub fn yarn_fit_schema() -> schemars::Schema {
@@ -411,20 +442,10 @@ pub fn fit_yarn(
     progress: &(dyn Fn(YarnFitEvent) + Sync),
 ) -> Result<Fitted, YarnFitError> {
     let started = Instant::now();
-    let bounds = problem.basis.bounds();
     let (swarm_report, mut x) = match start {
         Some(x) => (None, problem.clamped(x)),
         None => {
-            let coarse = problem.targets(settings.swarm_targets)?;
-            let report = swarm(
-                |x| problem.evaluate(x, &coarse).ok().map(|e| e.cost),
-                &bounds,
-                &settings.swarm,
-                &|g, best| progress(YarnFitEvent::Generation(g, best)),
-            );
-            if !report.best_cost.is_finite() {
-                return Err(YarnFitError::NothingEvaluable(report.evaluations));
-            }
+            let report = global_step(problem, settings, &[], progress)?;
             let best = report.best.clone();
             (Some(report), best)
         }
@@ -459,6 +480,28 @@ pub fn fit_yarn(
         wall_time_s: started.elapsed().as_secs_f64(),
     };
     Ok(Fitted { fit, rest_pattern: evaluation.rest_pattern, model })
+}
+
+/// The particle swarm on `settings.swarm_targets` targets per direction, particles starting at
+/// `seeds` first.
+pub fn global_step(
+    problem: &YarnProblem,
+    settings: &YarnFitSettings,
+    seeds: &[Vec<f64>],
+    progress: &(dyn Fn(YarnFitEvent) + Sync),
+) -> Result<SwarmReport, YarnFitError> {
+    let coarse = problem.targets(settings.swarm_targets)?;
+    let report = swarm(
+        |x| problem.evaluate(x, &coarse).ok().map(|e| e.cost),
+        &problem.basis.bounds(),
+        &settings.swarm,
+        seeds,
+        &|g, best| progress(YarnFitEvent::Generation(g, best)),
+    );
+    if !report.best_cost.is_finite() {
+        return Err(YarnFitError::NothingEvaluable(report.evaluations));
+    }
+    Ok(report)
 }
 
 /// The local step from `x`: the report and the point reached.

@@ -87,6 +87,17 @@ impl DirectionTargets {
         }
     }
 
+    /// The targets whose index `keep` accepts (the comfort range and normalizations unchanged).
+    pub fn subset(&self, keep: impl Fn(usize) -> bool) -> Self {
+        let pick = |v: &[f64]| v.iter().enumerate().filter(|(i, _)| keep(*i)).map(|(_, x)| *x).collect();
+        DirectionTargets {
+            stretch: pick(&self.stretch),
+            compression: pick(&self.compression),
+            stress_n_m: pick(&self.stress_n_m),
+            ..self.clone()
+        }
+    }
+
     /// Targets read off a simulated curve (a yarn model as ground truth); the comfort range ends
     /// where the clamp force `σ_s w` of a swatch of width `width_m` reaches `comfort_force_n`
     /// (linear interpolation between the curve's points).

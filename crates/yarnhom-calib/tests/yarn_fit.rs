@@ -89,10 +89,11 @@ fn the_stretch_stress_is_the_energy_slope_and_the_compression_leaves_no_orthogon
 
 fn truth_problem() -> YarnProblem {
     let pattern = stockinette();
+    let basis = basis(&pattern);
     YarnProblem {
-        basis: basis(&pattern),
+        basis,
         pattern,
-        source: TargetSource::Yarn(TRUTH.to_vec()),
+        source: TargetSource::Yarn(basis.params(&TRUTH)),
         directions: vec![(Direction::Weft, 0.5, 0.06), (Direction::Warp, 0.5, 0.06)],
         rest: RestShapeSettings { max_length_change: 0.2, max_resets: 8 },
         comfort_force_n: COMFORT_FORCE_N,

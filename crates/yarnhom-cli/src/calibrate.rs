@@ -16,11 +16,15 @@ use yarnhom_calib::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, s
 
 /// Areal density of synthetic sets with bending tests (kg/m²): a mid-weight knit.
 const SYNTH_AREAL_DENSITY_KG_M2: f64 = 0.25;
+use yarnhom_calib::swarm::SwarmSettings;
 use yarnhom_calib::targets::{Target, TargetPlan};
+use yarnhom_calib::yarn_confirm::{YarnLevel, confirm_diagnosis, skipped};
+use yarnhom_calib::yarn_fit::{LocalSolver, YarnFitEvent, YarnFitSettings};
 
 use yarnhom_shell::HingeBending;
 
 use crate::Outcome;
+use crate::calibrate_yarn::{set_basis, set_pattern};
 use crate::fit_plot::{FONT, format_value, plot_error, render};
 
 #[derive(Debug, Subcommand)]
@@ -85,12 +89,33 @@ fn parse_direction(name: &str) -> Result<Direction, String> {
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum Budget {
-    /// Coarse swatches (8 mm), 10 optimizer iterations per model.
+    /// Coarse swatches (8 mm), 10 optimizer iterations per model; no yarn-level confirmation.
     Quick,
-    /// 5 mm swatches, 30 iterations per model.
+    /// 5 mm swatches, 30 iterations per model; the cause confirmed on the tile by a reduced
+    /// yarn-level fit (swarm 16 x 3 on 5 targets per direction, Gauss-Newton 8 Jacobians on 8).
     Normal,
-    /// 3.5 mm swatches, 80 iterations per model.
+    /// 3.5 mm swatches, 80 iterations per model; the confirmation by the full yarn-level fit
+    /// (swarm 64 x 10 on 7 targets, Gauss-Newton 20 Jacobians on 20).
     Thorough,
+}
+
+impl Budget {
+    /// The yarn-level confirmation's fit settings (none for `quick`).
+    fn confirmation(self) -> Option<YarnFitSettings> {
+        let (particles, generations, swarm_targets, local_targets, local_budget) = match self {
+            Budget::Quick => return None,
+            Budget::Normal => (16, 3, 5, 8, 8),
+            Budget::Thorough => (64, 10, 7, 20, 20),
+        };
+        Some(YarnFitSettings {
+            swarm: SwarmSettings { particles, generations, ..SwarmSettings::default() },
+            swarm_targets,
+            local_targets,
+            local: LocalSolver::GaussNewton,
+            local_budget,
+            ..YarnFitSettings::default()
+        })
+    }
 }
 
 #[derive(Debug, Args)]
@@ -106,9 +131,14 @@ pub struct DiagnoseArgs {
     /// The stretch range ends where the measured force reaches this (N).
     #[arg(long, default_value_t = 5.0)]
     pub force_cap: f64,
-    /// Time against confidence: mesh size and optimizer iterations per model.
+    /// Time against confidence: mesh size and optimizer iterations per model, and the size of
+    /// the yarn-level confirmation (none with `quick`).
     #[arg(long, value_enum, default_value = "normal")]
     pub budget: Budget,
+    /// Known yarn stretch stiffness k_s2 (N) for the yarn-level confirmation; default: the
+    /// stiffest of the set's yarns, else fitted.
+    #[arg(long)]
+    pub yarn_stiffness: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -255,6 +285,9 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
         args.force_cap.is_finite() && args.force_cap > 0.0,
         "--force-cap must be a positive number of newtons"
     );
+    if let Some(k) = args.yarn_stiffness {
+        anyhow::ensure!(k.is_finite() && k > 0.0, "--yarn-stiffness must be a positive force in newtons");
+    }
     let set = MeasurementSet::read(&args.set)?;
     let (spacing_m, max_iterations) = match args.budget {
         Budget::Quick => (0.008, 10),
@@ -273,7 +306,37 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
         set.stretch.len(),
         CauseId::CANDIDATES.len()
     );
-    let d = diagnose(&set, &settings)?;
+    let mut d = diagnose(&set, &settings)?;
+    d.yarn_level = Some(match args.budget.confirmation() {
+        None => YarnLevel::NotRun {
+            reason:
+                "--budget quick screens at the shell level only (normal or thorough confirm on the yarn tile)"
+                    .into(),
+        },
+        Some(fit) => {
+            skipped(d.cause.id).unwrap_or_else(|| match set_pattern(&args.set, &set.fabric.pattern) {
+                Err(e) => YarnLevel::NotRun { reason: format!("the set's pattern: {e:#}") },
+                Ok(pattern) => {
+                    let basis = set_basis(&set, &pattern, args.yarn_stiffness);
+                    eprintln!(
+                        "confirming {} on the yarn tile '{}' ({} vertices) ...",
+                        d.cause.id.as_str(),
+                        pattern.name,
+                        pattern.vertex_count()
+                    );
+                    let progress = |event: YarnFitEvent| match event {
+                        YarnFitEvent::Generation(g, best) => {
+                            eprintln!("  swarm generation {g}: best g = {best:.5}")
+                        }
+                        YarnFitEvent::LocalEvaluation(n, cost) => {
+                            eprintln!("  local evaluation {n}: g = {cost:.5}")
+                        }
+                    };
+                    confirm_diagnosis(&set, &d, pattern, basis, &fit, &progress)
+                }
+            })
+        }
+    });
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create {}", args.output.display()))?;
     let write = |name: &str, text: String| -> Result<()> {
@@ -297,6 +360,11 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
         "held-out error {:.4} -> {:.4}; {:.1} s",
         d.gain.heldout_error_before, d.gain.heldout_error_after, d.wall_time_s
     );
+    match &d.yarn_level {
+        Some(YarnLevel::Confirmation(c)) => println!("yarn level: {} ({:.1} s)", c.verdict, c.wall_time_s),
+        Some(YarnLevel::NotRun { reason }) => println!("yarn level: not run: {reason}"),
+        None => {}
+    }
     eprintln!("wrote {}/{written}", args.output.display());
     Ok(Outcome::Success)
 }
@@ -371,6 +439,7 @@ Held-out error (RMS normalized residual on targets not fitted): {} before, {} af
             );
         }
     }
+    md += &yarn_level_markdown(d.yarn_level.as_ref());
     md += "
 ## Figures
 
@@ -387,6 +456,47 @@ Held-out error (RMS normalized residual on targets not fitted): {} before, {} af
         d.unload_targets.len(),
         d.wall_time_s
     );
+    md
+}
+
+/// The yarn-level confirmation's section of `report.md`.
+fn yarn_level_markdown(level: Option<&YarnLevel>) -> String {
+    let c = match level {
+        None => return String::new(),
+        Some(YarnLevel::NotRun { reason }) => {
+            return format!("\n## Yarn-level confirmation\n\nNot run: {reason}.\n");
+        }
+        Some(YarnLevel::Confirmation(c)) => c,
+    };
+    let mut md = format!(
+        "\n## Yarn-level confirmation\n\n**{}** — {}\n\nTile `{}`; targets: the extended shell's uniform tests, {} per \
+         direction fitted and as many held out between them; swarm {} evaluations, then {:?} from its best for both \
+         models; {:.1} s.\n\n| yarn model | parameters | fitted error | held-out error | criterion (AIC) | local evaluations |\n|---|---|---|---|---|---|\n",
+        if c.confirmed { "Confirmed" } else { "Not confirmed" },
+        c.verdict,
+        c.pattern,
+        c.settings.local_targets,
+        c.swarm_evaluations,
+        c.settings.local,
+        c.wall_time_s
+    );
+    for (name, m) in [("base (linear stretch, single-phase contact)", &c.base), ("extended", &c.extended)] {
+        md += &format!(
+            "| {name} | {} | {:.4} | {:.4} | {:.1} | {} |\n",
+            m.coordinates.len(),
+            m.error,
+            m.heldout_error,
+            m.criterion,
+            m.evaluations
+        );
+    }
+    for (name, m) in [("Base yarn parameters", &c.base), ("Extended yarn parameters", &c.extended)] {
+        md += &format!("\n### {name}\n\n");
+        let p = serde_json::to_value(m.params).unwrap_or_default();
+        for (key, value) in p.as_object().into_iter().flatten() {
+            md += &format!("- `{key}` = {value}\n");
+        }
+    }
     md
 }
 

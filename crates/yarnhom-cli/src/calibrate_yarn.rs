@@ -110,12 +110,8 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
             fit
         }
     };
-    let k_s2 =
-        args.yarn_stiffness.or_else(|| set.fabric.yarn.iter().filter_map(|y| y.stiffness_n).reduce(f64::max));
-    let radius = pattern.radius_range_m().0;
-    let tex = set.fabric.yarn.iter().find_map(|y| y.linear_density_tex);
-    let density = tex.map_or(DEFAULT_DENSITY_KG_M3, |t| t * 1e-6 / (std::f64::consts::PI * radius * radius));
-    let basis = YarnBasis::of_pattern(&pattern, k_s2, density);
+    let basis = set_basis(&set, &pattern, args.yarn_stiffness);
+    let k_s2 = basis.k_s2_n;
     let (particles, seed) = match args.shard {
         Some((k, n)) => ((args.particles / n).max(1) as usize, args.seed.wrapping_add(u64::from(k) * 7919)),
         None => (args.particles as usize, args.seed),
@@ -176,9 +172,20 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
+/// The fixed quantities of a yarn-level fit of `set` on `pattern`: `k_s2` is `yarn_stiffness`,
+/// else the stiffest of the set's yarns, else fitted; the density from the yarns' linear density.
+pub(crate) fn set_basis(set: &MeasurementSet, pattern: &Pattern, yarn_stiffness: Option<f64>) -> YarnBasis {
+    let k_s2 =
+        yarn_stiffness.or_else(|| set.fabric.yarn.iter().filter_map(|y| y.stiffness_n).reduce(f64::max));
+    let radius = pattern.radius_range_m().0;
+    let tex = set.fabric.yarn.iter().find_map(|y| y.linear_density_tex);
+    let density = tex.map_or(DEFAULT_DENSITY_KG_M3, |t| t * 1e-6 / (std::f64::consts::PI * radius * radius));
+    YarnBasis::of_pattern(pattern, k_s2, density)
+}
+
 /// The set's input geometry: a pattern file (relative to the set directory, or as given) or a
 /// built-in generator at its default stitch size.
-fn set_pattern(set_dir: &Path, spec: &str) -> Result<Pattern> {
+pub(crate) fn set_pattern(set_dir: &Path, spec: &str) -> Result<Pattern> {
     let candidates = [set_dir.join(spec), PathBuf::from(spec)];
     if let Some(path) = candidates.iter().find(|p| p.is_file()) {
         let loaded = inputs::load(path, None)?;

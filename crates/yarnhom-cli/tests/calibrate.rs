@@ -127,9 +127,19 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
         "/candidates/0/id",
         "/candidates/0/error",
         "/candidates/0/criterion",
+        "/extended_material/k_xx",
     ] {
         assert!(report.pointer(field).is_some(), "report.json lacks {field}");
     }
+    // The quick budget screens only; the report says so.
+    assert_eq!(report.pointer("/yarn_level/status").and_then(|v| v.as_str()), Some("not-run"));
+    assert!(
+        report
+            .pointer("/yarn_level/reason")
+            .and_then(|v| v.as_str())
+            .is_some_and(|r| r.contains("--budget quick")),
+        "{report}"
+    );
     let before = report.pointer("/gain/heldout_error_before").and_then(|v| v.as_f64()).expect("number");
     let after = report.pointer("/gain/heldout_error_after").and_then(|v| v.as_f64()).expect("number");
     assert!(after < before, "{after} vs {before}");
