@@ -37,8 +37,10 @@ use yarnhom_shell::StvkNeoHookean;
 
 use crate::diagnose::{CauseId, Diagnosis};
 use crate::measure::{Direction, MeasurementSet};
+use crate::swarm::SwarmSettings;
 use crate::yarn_fit::{
-    TargetSource, YarnFitError, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn, global_step,
+    LocalSolver, TargetSource, YarnFitError, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn,
+    global_step,
 };
 use crate::yarn_objective::{DirectionTargets, YarnErrors, errors, residuals};
 use crate::yarn_params::{InnerContact, YarnBasis, YarnMechanisms, YarnParams};
@@ -51,6 +53,33 @@ pub const MIN_BASE_ERROR: f64 = 0.03;
 
 /// The Akaike criterion must drop by more than this.
 const MIN_CRITERION_DROP: f64 = 4.0;
+
+/// How large the confirmation's search is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchSize {
+    /// Swarm 16 x 3 on 5 targets per direction, Gauss-Newton 8 Jacobians on 8.
+    Reduced,
+    /// The thesis' swarm, 64 x 10 on 7 targets, Gauss-Newton 20 Jacobians on 20.
+    Full,
+}
+
+impl SearchSize {
+    /// The fit settings of this size (both models get them).
+    pub fn settings(self) -> YarnFitSettings {
+        let (particles, generations, swarm_targets, local_targets, local_budget) = match self {
+            SearchSize::Reduced => (16, 3, 5, 8, 8),
+            SearchSize::Full => (64, 10, 7, 20, 20),
+        };
+        YarnFitSettings {
+            swarm: SwarmSettings { particles, generations, ..SwarmSettings::default() },
+            swarm_targets,
+            local_targets,
+            local: LocalSolver::GaussNewton,
+            local_budget,
+            ..YarnFitSettings::default()
+        }
+    }
+}
 
 /// The yarn-level mechanism of a cause, as the mechanisms of the extended yarn model.
 pub fn yarn_mechanism(cause: CauseId) -> Option<YarnMechanisms> {

@@ -7,8 +7,8 @@
 use yarnhom_calib::Direction;
 use yarnhom_calib::diagnose::CauseId;
 use yarnhom_calib::swarm::SwarmSettings;
-use yarnhom_calib::yarn_confirm::{CONFIRM_RATIO, YarnConfirmation, confirm};
-use yarnhom_calib::yarn_fit::{LocalSolver, RestShapeSettings, TargetSource, YarnFitSettings, YarnProblem};
+use yarnhom_calib::yarn_confirm::{CONFIRM_RATIO, SearchSize, YarnConfirmation, confirm};
+use yarnhom_calib::yarn_fit::{RestShapeSettings, TargetSource, YarnFitSettings, YarnProblem};
 use yarnhom_calib::yarn_objective::COMFORT_FORCE_N;
 use yarnhom_calib::yarn_params::{YarnBasis, YarnMechanisms, YarnParams};
 
@@ -38,18 +38,17 @@ fn biphasic(basis: &YarnBasis) -> YarnParams {
     YarnParams { k_s1_n: p.k_s2_n / 10.0, eps_bar: 0.05, ..p }
 }
 
-/// The confirmation's fit settings: `calibrate diagnose --budget thorough`'s (the thesis' swarm,
-/// Gauss-Newton with 20 Jacobians on 20 targets), or a small search.
+/// The confirmation's fit settings: `calibrate diagnose --budget thorough`'s, or a small search.
 fn settings(thorough: bool) -> YarnFitSettings {
-    let (particles, generations, swarm_targets, local_targets, local_budget) =
-        if thorough { (64, 10, 7, 20, 20) } else { (8, 2, 4, 5, 4) };
+    if thorough {
+        return SearchSize::Full.settings();
+    }
     YarnFitSettings {
-        swarm: SwarmSettings { particles, generations, ..SwarmSettings::default() },
-        swarm_targets,
-        local_targets,
-        local: LocalSolver::GaussNewton,
-        local_budget,
-        ..YarnFitSettings::default()
+        swarm: SwarmSettings { particles: 8, generations: 2, ..SwarmSettings::default() },
+        swarm_targets: 4,
+        local_targets: 5,
+        local_budget: 4,
+        ..SearchSize::Reduced.settings()
     }
 }
 

@@ -16,10 +16,9 @@ use yarnhom_calib::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, s
 
 /// Areal density of synthetic sets with bending tests (kg/m²): a mid-weight knit.
 const SYNTH_AREAL_DENSITY_KG_M2: f64 = 0.25;
-use yarnhom_calib::swarm::SwarmSettings;
 use yarnhom_calib::targets::{Target, TargetPlan};
-use yarnhom_calib::yarn_confirm::{YarnLevel, confirm_diagnosis, skipped};
-use yarnhom_calib::yarn_fit::{LocalSolver, YarnFitEvent, YarnFitSettings};
+use yarnhom_calib::yarn_confirm::{SearchSize, YarnLevel, confirm_diagnosis, skipped};
+use yarnhom_calib::yarn_fit::{YarnFitEvent, YarnFitSettings};
 
 use yarnhom_shell::HingeBending;
 
@@ -102,19 +101,11 @@ pub enum Budget {
 impl Budget {
     /// The yarn-level confirmation's fit settings (none for `quick`).
     fn confirmation(self) -> Option<YarnFitSettings> {
-        let (particles, generations, swarm_targets, local_targets, local_budget) = match self {
-            Budget::Quick => return None,
-            Budget::Normal => (16, 3, 5, 8, 8),
-            Budget::Thorough => (64, 10, 7, 20, 20),
-        };
-        Some(YarnFitSettings {
-            swarm: SwarmSettings { particles, generations, ..SwarmSettings::default() },
-            swarm_targets,
-            local_targets,
-            local: LocalSolver::GaussNewton,
-            local_budget,
-            ..YarnFitSettings::default()
-        })
+        match self {
+            Budget::Quick => None,
+            Budget::Normal => Some(SearchSize::Reduced.settings()),
+            Budget::Thorough => Some(SearchSize::Full.settings()),
+        }
     }
 }
 
