@@ -117,6 +117,14 @@ impl<const N: usize> SplitHessian<N> {
             None => self.exact,
         }
     }
+
+    /// `H` with its eigenvalues replaced by their absolute values.
+    pub fn absolute(&self) -> SMatrix<f64, N, N> {
+        match &self.negative {
+            Some(n) => self.exact - 2.0 * n,
+            None => self.exact,
+        }
+    }
 }
 
 /// Whether a symmetric matrix is positive semidefinite up to rounding: a Cholesky
@@ -448,6 +456,14 @@ mod tests {
         let p = split.clamped();
         assert!(p.symmetric_eigenvalues().iter().all(|&l| l >= -1e-14));
         assert!((p[(5, 5)] - 1.0).abs() < 1e-14 && p[(1, 1)] > -1.0);
+        // The absolute Hessian has the absolute eigenvalues.
+        let sorted = |mut l: Vec<f64>| {
+            l.sort_by(f64::total_cmp);
+            l
+        };
+        let flipped = sorted(split.absolute().symmetric_eigenvalues().iter().copied().collect());
+        let expected = sorted(a.symmetric_eigenvalues().iter().map(|l| l.abs()).collect());
+        assert!(flipped.iter().zip(&expected).all(|(f, e)| (f - e).abs() < 1e-12), "{flipped:?}");
         let spd = SMatrix::<f64, 18, 18>::identity() * 2.0;
         assert!(split_hessian_18(spd).negative.is_none());
     }
