@@ -355,16 +355,7 @@ mod tests {
     fn stvk() -> ShellMaterial {
         ShellMaterial::stvk(
             0.3,
-            StvkNeoHookean {
-                k_xx: 3.0,
-                k_xy: 0.5,
-                k_yy: 1.0,
-                k_ss: 0.7,
-                k_n1: 0.2,
-                k_n2: 0.1,
-                stiffening: None,
-                jamming: None,
-            },
+            crate::test_support::test_membrane(),
             HingeBending {
                 k_weft: 1e-4,
                 k_bias: 2e-4,

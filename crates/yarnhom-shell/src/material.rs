@@ -230,14 +230,9 @@ mod tests {
     #[test]
     fn stvk_derivatives_match_finite_differences_and_rest_is_stress_free() {
         let m = StvkNeoHookean {
-            k_xx: 3.0,
-            k_xy: 0.5,
-            k_yy: 1.0,
-            k_ss: 0.7,
-            k_n1: 0.2,
-            k_n2: 0.1,
             stiffening: Some(Stiffening { k_weft: 5.0, k_warp: 2.0, onset: 0.1 }),
             jamming: Some(Stiffening { k_weft: 4.0, k_warp: 3.0, onset: 0.02 }),
+            ..crate::test_support::test_membrane()
         };
         let rest = m.jet([1.0, 0.0, 1.0]);
         assert!(rest.value.abs() < 1e-15 && rest.gradient.norm() < 1e-15);

@@ -276,20 +276,11 @@ mod tests {
     #[test]
     fn the_pattern_assembly_is_the_triplet_assembly() {
         use crate::elastic::{Assembly, ElasticModel};
-        use crate::material::{HingeBending, ShellMaterial, StvkNeoHookean};
+        use crate::material::{HingeBending, ShellMaterial};
         use crate::mesh::ShellMesh;
         let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
         let spline = yarnhom_artifacts::arcsim::read_spline(std::path::Path::new(&path)).expect("published");
-        let stvk = StvkNeoHookean {
-            k_xx: 3.0,
-            k_xy: 0.5,
-            k_yy: 1.0,
-            k_ss: 0.7,
-            k_n1: 0.2,
-            k_n2: 0.1,
-            stiffening: None,
-            jamming: None,
-        };
+        let stvk = crate::test_support::test_membrane();
         let materials = [
             ShellMaterial::spline(yarnhom_fit::SplineMaterial::from(&spline)),
             ShellMaterial::stvk(0.3, stvk, HingeBending::anisotropic(1e-4, 2e-4, 3e-4)),

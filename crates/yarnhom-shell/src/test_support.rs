@@ -146,3 +146,17 @@ impl GridMesh {
         far
     }
 }
+
+/// An anisotropic (6.1) membrane with area terms and nothing else, for tests.
+pub fn test_membrane() -> crate::material::StvkNeoHookean {
+    crate::material::StvkNeoHookean {
+        k_xx: 3.0,
+        k_xy: 0.5,
+        k_yy: 1.0,
+        k_ss: 0.7,
+        k_n1: 0.2,
+        k_n2: 0.1,
+        stiffening: None,
+        jamming: None,
+    }
+}
