@@ -350,7 +350,7 @@ impl ElasticModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{HingeBending, StvkNeoHookean};
+    use crate::material::HingeBending;
 
     fn stvk() -> ShellMaterial {
         ShellMaterial::stvk(
