@@ -336,7 +336,9 @@ fn residuals(
     (fitted, heldout)
 }
 
-fn criterion(r: &[f64], parameters: usize) -> f64 {
+/// The Akaike criterion of residuals `r` of a model with `parameters` fitted parameters,
+/// `n ln(RSS/n) + 2k`.
+pub(crate) fn criterion(r: &[f64], parameters: usize) -> f64 {
     let n = r.len().max(1) as f64;
     n * (r.iter().map(|x| x * x).sum::<f64>() / n).max(1e-300).ln() + 2.0 * parameters as f64
 }

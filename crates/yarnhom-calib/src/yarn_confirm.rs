@@ -35,8 +35,9 @@ use serde::{Deserialize, Serialize};
 use yarnhom_artifacts::Pattern;
 use yarnhom_shell::StvkNeoHookean;
 
-use crate::diagnose::{CauseId, Diagnosis};
+use crate::diagnose::{CauseId, Diagnosis, criterion};
 use crate::measure::{Direction, MeasurementSet};
+use crate::shell_fit::rms;
 use crate::swarm::SwarmSettings;
 use crate::yarn_fit::{
     LocalSolver, TargetSource, YarnFitError, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn,
@@ -238,16 +239,6 @@ fn fit_and_score(
         errors: errors(&fit.targets, &fit.simulated),
         evaluations: fit.local.as_ref().map_or(0, |l| l.evaluations),
     })
-}
-
-fn rms(r: &[f64]) -> f64 {
-    (r.iter().map(|x| x * x).sum::<f64>() / r.len().max(1) as f64).sqrt()
-}
-
-/// `n ln(RSS/n) + 2k`.
-fn criterion(r: &[f64], parameters: usize) -> f64 {
-    let n = r.len().max(1) as f64;
-    n * (r.iter().map(|x| x * x).sum::<f64>() / n).max(1e-300).ln() + 2.0 * parameters as f64
 }
 
 /// Whether the extension confirms `cause`, and the sentence saying so.
