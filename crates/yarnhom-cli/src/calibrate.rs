@@ -461,14 +461,18 @@ fn yarn_level_markdown(level: Option<&YarnLevel>) -> String {
     };
     let mut md = format!(
         "\n## Yarn-level confirmation\n\n**{}** — {}\n\nTile `{}`; targets: the extended shell's uniform tests, {} per \
-         direction fitted and as many held out between them; swarm {} evaluations, then {:?} from its best for both \
-         models; {:.1} s.\n\n| yarn model | parameters | fitted error | held-out error | criterion (AIC) | local evaluations |\n|---|---|---|---|---|---|\n",
+         direction fitted and as many held out between them; a swarm per model ({} evaluations in all, the \
+         extension's seeded with the base's optimum), then {} local steps from their best (and the base's second \
+         from the extension's optimum); {:.1} s.\n\n| yarn model | parameters | fitted error | held-out error | criterion (AIC) | local evaluations |\n|---|---|---|---|---|---|\n",
         if c.confirmed { "Confirmed" } else { "Not confirmed" },
         c.verdict,
         c.pattern,
         c.settings.local_targets,
         c.swarm_evaluations,
-        c.settings.local,
+        serde_json::to_value(c.settings.local)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_default(),
         c.wall_time_s
     );
     for (name, m) in [("base (linear stretch, single-phase contact)", &c.base), ("extended", &c.extended)] {
