@@ -24,7 +24,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
 use crate::elastic::{Assembly, ElasticModel};
 use crate::line_search::backtrack;
-use crate::pattern::{HessianPattern, NewtonAssembly};
+use crate::newton_matrix::{HessianPattern, NewtonAssembly};
 
 /// A piecewise linear translation over time (keyframes `(time_s, translation_m)`), constant
 /// before the first and after the last key.

@@ -22,7 +22,7 @@ pub mod integrator;
 mod line_search;
 pub mod material;
 pub mod mesh;
-mod pattern;
+mod newton_matrix;
 pub mod scene;
 pub mod simulate;
 pub mod statics;
