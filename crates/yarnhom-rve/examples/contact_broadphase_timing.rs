@@ -80,7 +80,7 @@ fn main() {
                     for b in 0..model.vertices {
                         if (a < b || (a == b && o > [0, 0]))
                             && culled(a, image, b)
-                            && !model.neighbours.are_neighbours(a as u32, b as u32, o)
+                            && model.contact_pair(a, b, o)
                         {
                             count += 1;
                         }

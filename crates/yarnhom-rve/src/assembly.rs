@@ -4,6 +4,7 @@
 //! back to the tile DOFs through `x = ... + R(X) g`: `∇_g = Rᵀ ∇_x`, `H_gg' = Rᵀ H_xx' R'`.
 
 use nalgebra::{DVector, Matrix3, Vector3};
+use yarnhom_geom::segment_distance;
 use yarnhom_pattern::min_distance::lower_bound;
 use yarnhom_rod::{
     BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
@@ -423,6 +424,26 @@ fn add_contacts(
         let lower = want == Want::DerivativesLower;
         Scatter { model, placement, out: &mut *out, lower }.add(&instances, &[], grad.as_slice(), h);
     }
+}
+
+/// The smallest centreline distance (m) between two yarn pieces of the tile and its images at
+/// `state` (neighbours along a yarn excluded, as in contact), among the pairs within contact
+/// reach; `None` when no pair is within reach. Touching yarns of radius `R` are `2R` apart; a
+/// distance below `R` puts a centreline inside another yarn (the tile self-intersects).
+pub fn min_separation(model: &RveModel, placement: &Placement, state: &RveState) -> Option<f64> {
+    let candidates = ContactCandidates::new(model, placement, &state.g, 0.0);
+    let position = |i: Instance, o: [i32; 2]| position_of(model, placement, &state.g, shifted(i, o));
+    candidates
+        .pairs
+        .iter()
+        .map(|&EdgePair { a, image, b }| {
+            let (sa, sb, o) = (model.stretch[a], model.stretch[b], model.images[image]);
+            let (a0, a1) = (position(sa.from, [0, 0]), position(sa.to, [0, 0]));
+            let (b0, b1) = (position(sb.from, o), position(sb.to, o));
+            segment_distance(&a0, &a1, &b0, &b1).distance
+        })
+        .filter(|d| *d < model.contact.reach_m())
+        .min_by(f64::total_cmp)
 }
 
 /// The instance `i` moved by the tile offset `o`.

@@ -70,13 +70,9 @@ pub fn edge_pairs(model: &RveModel, boxes: &[Vec<Aabb>]) -> Vec<EdgePair> {
     for (image, (&o, image_boxes)) in model.images.iter().zip(boxes).enumerate() {
         for (b, query) in image_boxes.iter().enumerate().filter(|(_, q)| q.overlaps(&tile_bounds)) {
             grid.overlapping(query, &mut hits);
-            let source_b = model.stretch[b].from.vertex;
             pairs.extend(
                 hits.iter()
-                    .filter(|&&a| {
-                        (a < b || (a == b && o > [0, 0]))
-                            && !model.neighbours.are_neighbours(model.stretch[a].from.vertex, source_b, o)
-                    })
+                    .filter(|&&a| (a < b || (a == b && o > [0, 0])) && model.contact_pair(a, b, o))
                     .map(|&a| EdgePair { a, image, b }),
             );
         }
@@ -241,10 +237,7 @@ mod tests {
         for a in 0..model.vertices {
             for (image, &o) in model.images.iter().enumerate() {
                 for b in 0..model.vertices {
-                    if (a < b || (a == b && o > [0, 0]))
-                        && !model.neighbours.are_neighbours(a as u32, b as u32, o)
-                        && keep(a, image, b)
-                    {
+                    if (a < b || (a == b && o > [0, 0])) && model.contact_pair(a, b, o) && keep(a, image, b) {
                         pairs.push(EdgePair { a, image, b });
                     }
                 }

@@ -243,9 +243,7 @@ mod tests {
             for a in 0..model.vertices {
                 for (image, &o) in model.images.iter().enumerate() {
                     for b in 0..model.vertices {
-                        if !(a < b || (a == b && o > [0, 0]))
-                            || model.neighbours.are_neighbours(a as u32, b as u32, o)
-                        {
+                        if !(a < b || (a == b && o > [0, 0])) || !model.contact_pair(a, b, o) {
                             continue;
                         }
                         let distance = |e: &[Vec<(Vector3<f64>, Vector3<f64>)>]| {

@@ -2,6 +2,7 @@
 
 use nalgebra::Vector3;
 use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel};
+use yarnhom_geom::segment_distance;
 use yarnhom_pattern::YarnNeighbours;
 use yarnhom_rod::{BendTwist, ContactLaw, RodMaterial, StretchLaw};
 
@@ -201,6 +202,36 @@ impl RveModel {
     /// Tile area `P1 P2` (m²): homogenized densities are per unit undeformed area (3.22).
     pub fn area_m2(&self) -> f64 {
         self.period_m[0] * self.period_m[1]
+    }
+
+    /// Whether edge `a` of the tile and edge `b` of tile image `o` (edges by source vertex) are
+    /// a contact pair: not neighbours along one yarn ([`YarnNeighbours`]) and able to touch
+    /// ([`Self::can_touch`]).
+    pub fn contact_pair(&self, a: usize, b: usize, o: [i32; 2]) -> bool {
+        !self.neighbours.are_neighbours(a as u32, b as u32, o) && self.can_touch(a, b, o)
+    }
+
+    /// Whether edge `a` of the tile and edge `b` of tile image `o` can touch: their pieces lie
+    /// within contact reach plus the smaller period in the material configuration (the period
+    /// is room for yarns to slide past each other). Pieces farther apart in the fabric meet
+    /// only where the macro deformation brings the fabric round onto itself: bent to curvature
+    /// `κ`, the tile's surface repeats after `2π/κ` of material length, so an image that far
+    /// away lands on the tile itself (for the published stockinette's 15.1 mm period and its
+    /// images two periods out, from `κ = 2π/(3 P_1) = 139 1/m` on). That is the same fabric seen
+    /// again, not a second layer: contact across it is macro-scale self-contact (the shell's
+    /// concern), and counting it in the tile gives the homogenized energy a spurious wall.
+    pub fn can_touch(&self, a: usize, b: usize, o: [i32; 2]) -> bool {
+        let offset =
+            Vector3::new(f64::from(o[0]) * self.period_m[0], f64::from(o[1]) * self.period_m[1], 0.0);
+        let segment = |e: usize, shift: Vector3<f64>| {
+            let s = &self.stretch[e];
+            let start = self.material[s.from.vertex as usize] + shift;
+            (start, start + material_edge(&self.material, self.period_m, s))
+        };
+        let (a0, a1) = segment(a, Vector3::zeros());
+        let (b0, b1) = segment(b, offset);
+        let slack = self.period_m[0].min(self.period_m[1]);
+        segment_distance(&a0, &a1, &b0, &b1).distance <= self.contact.reach_m() + slack
     }
 }
 

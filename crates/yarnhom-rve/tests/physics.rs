@@ -1,11 +1,11 @@
 //! Physics of the published patterns with their Table 4.1 parameters (issue 3, "Validation").
-//! About 7 s in all (the rib tile's solves take 3 s each).
+//! About 8 s in all (the rib tile's solves take 3 s each).
 
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_fit::SplineMaterial;
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::solve_at;
+use yarnhom_rve::homogenize::{placement, solve_at};
 use yarnhom_rve::{RveModel, SolveOptions};
 
 fn tile(name: &str) -> RveModel {
@@ -66,5 +66,37 @@ fn stretch_response_matches_the_published_fits() {
     }
     for w in ours.windows(2) {
         assert!(w[0].0 > w[1].0 && w[0].1 > w[1].1, "ranking differs: {ours:?}");
+    }
+}
+
+#[test]
+fn a_tile_bent_round_onto_itself_has_no_contact_wall() {
+    // The published stockinette (period 15.1 mm along X1, contact images two periods out) bent
+    // past kx = 2π/(3 P_1) = 139 1/m brings an image round onto the tile itself; that is the
+    // same fabric again, not a second layer, so the energy must continue smoothly (before the
+    // material-proximity rule of `RveModel::can_touch` it jumped from 1.26 to 7.6 J/m² between
+    // kx = 130 and 140, the yarns 0.32 radii apart).
+    let stock = tile("stock");
+    let mut state = None;
+    let mut energies = Vec::new();
+    for kx in [120.0, 130.0, 140.0, 150.0, 160.0] {
+        let strain: MacroStrain = format!("kx={kx}").parse().expect("strain");
+        let options = if state.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
+        let (report, solved) = solve_at(&stock, &strain, state.as_ref(), &options);
+        assert!(report.converged, "kx = {kx}: {report:?}");
+        let separation = yarnhom_rve::assembly::min_separation(&stock, &placement(&stock, &strain), &solved)
+            .expect("yarns in contact");
+        println!(
+            "  kx = {kx}: psi {:.4} J/m², yarns {:.3} radii apart",
+            report.energy_density_j_m2,
+            separation / stock.radius_m
+        );
+        assert!(separation > 1.5 * stock.radius_m, "kx = {kx}: yarns {separation} m apart");
+        energies.push(report.energy_density_j_m2);
+        state = Some(solved);
+    }
+    let steps: Vec<f64> = energies.windows(2).map(|w| w[1] - w[0]).collect();
+    for pair in steps.windows(2) {
+        assert!(pair[1] > 0.0 && pair[1] < 1.5 * pair[0], "energy steps {steps:?}");
     }
 }
