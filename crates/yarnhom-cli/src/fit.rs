@@ -206,19 +206,20 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
             grid.samples.len()
         );
     }
-    print_errors(&fitted, &spline);
+    print_errors(&fitted, &spline, !args.no_shear_symmetry);
     print_shapes(&fitted, &spline);
     println!("wrote {}", output.display());
     Ok(Outcome::Success)
 }
 
 /// The fit's relative RMS error on each term of its grid (the acceptance figure).
-fn print_errors(grid: &Grid, spline: &Spline) {
+fn print_errors(grid: &Grid, spline: &Spline, symmetrized_shear: bool) {
     let material = SplineMaterial::from(spline);
     println!(
-        "relative RMS error of the fit on its grid: of Ψ; of Ψ - f0; of Ψ without 2D compression (A.3.6):"
+        "relative RMS error of the fit on its grid: of Ψ; of Ψ - f0; of Ψ as modelled (2D terms without compression, A.3.6{}):",
+        if symmetrized_shear { "; symmetrized in sa, Sec. 4.1" } else { "" }
     );
-    for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2) {
+    for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2, symmetrized_shear) {
         let modelled = e.relative_rms_modelled.map_or("-".to_string(), |r| format!("{:6.2}%", 100.0 * r));
         println!(
             "  {:8} {:5} samples  {:6.2}%  {:6.2}%  {modelled}",

@@ -13,7 +13,7 @@ use crate::march::{
     bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d,
     quasiconvexify_1d, zero_knot_index,
 };
-use crate::mls::{HermiteGrid, SmoothedEnergy1d, SmoothedEnergy2d};
+use crate::mls::{HermiteGrid, SmoothedEnergy1d, SmoothedEnergy2d, symexp, symlog};
 use crate::monotone_bicubic::make_monotone_bicubic;
 use crate::residual::{residualize_1d, residualize_2d, zero_compressed};
 
@@ -340,31 +340,57 @@ pub struct TermError {
     /// RMS of (fit - data) divided by the RMS of the deformation energy `data - f0`: the
     /// stricter figure, blind to the constant.
     pub relative_rms_deformation: f64,
-    /// `relative_rms` over the samples the model is built to represent: for 2D terms other
-    /// than `sx,sy`, those without compression (`sx, sy >= 0`), whose combined response the
-    /// thesis leaves to the 1D terms (A.3.6); `None` when no such samples remain.
+    /// `relative_rms` against the response the model is built to represent: for 2D terms other
+    /// than `sx,sy`, only the samples without compression (`sx, sy >= 0`), whose combined
+    /// response the thesis leaves to the 1D terms (A.3.6); for terms with `sa`, when the fit
+    /// symmetrizes shear, the data averaged with its mirror sample (`sa -> -sa`) in the symlog
+    /// space where the fit symmetrizes (A.35, Sec. 4.1: a tile that is not mirror symmetric
+    /// responds differently to the two senses of shear, and the fit represents their mean);
+    /// `None` when no such samples remain.
     pub relative_rms_modelled: Option<f64>,
 }
 
-/// The fit's error on each term of its grid.
-pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec<TermError> {
+/// The fit's error on each term of its grid; `symmetrized_shear` as the fit's
+/// [`FitSettings::symmetrize_shear`].
+pub fn fit_errors(
+    grid: &Grid,
+    material: &crate::SplineMaterial,
+    f0: f64,
+    symmetrized_shear: bool,
+) -> Vec<TermError> {
     grid.terms
         .iter()
         .enumerate()
         .map(|(t, term)| {
             let samples: Vec<&GridSample> =
                 grid.samples.iter().filter(|s| s.term as usize == t && s.converged).collect();
-            let pairs = |keep: &dyn Fn(&GridSample) -> bool| -> Vec<(f64, f64)> {
+            let energy = |index: [u32; 2]| {
+                samples.iter().find(|s| s.index == index).and_then(|s| s.energy_density_j_m2)
+            };
+            let shear_axis = term.axes.iter().position(|&a| a as usize == SHEAR);
+            let modelled_energy = |s: &GridSample| match shear_axis {
+                Some(k) if symmetrized_shear => {
+                    let mut mirror = s.index;
+                    mirror[k] = mirror_index(&term.values[k], s.index[k] as usize)? as u32;
+                    Some(symexp(0.5 * (symlog(s.energy_density_j_m2?) + symlog(energy(mirror)?))))
+                }
+                _ => s.energy_density_j_m2,
+            };
+            let pairs = |keep: &dyn Fn(&GridSample) -> bool,
+                         data: &dyn Fn(&GridSample) -> Option<f64>|
+             -> Vec<(f64, f64)> {
                 samples
                     .iter()
                     .filter(|s| keep(s))
-                    .filter_map(|s| s.energy_density_j_m2.map(|e| (material.energy_at(&s.strain), e)))
+                    .filter_map(|s| data(s).map(|e| (material.energy_at(&s.strain), e)))
                     .collect()
             };
-            let all = pairs(&|_| true);
+            let all = pairs(&|_| true, &|s| s.energy_density_j_m2);
             let uncompressed = term.axes.len() == 1 || term.axes.as_slice() == POISSON_PAIR.map(|a| a as u8);
-            let modelled =
-                pairs(&|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0));
+            let modelled = pairs(
+                &|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0),
+                &modelled_energy,
+            );
             TermError {
                 term: term.name(),
                 samples: all.len(),
@@ -374,6 +400,13 @@ pub fn fit_errors(grid: &Grid, material: &crate::SplineMaterial, f0: f64) -> Vec
             }
         })
         .collect()
+}
+
+/// The index of the value `-values[i]` among `values` (an axis sampled symmetrically about 0),
+/// if there is one.
+fn mirror_index(values: &[f64], i: usize) -> Option<usize> {
+    let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    values.iter().position(|v| (v + values[i]).abs() <= 1e-9 * scale)
 }
 
 /// RMS of (fit - data) over RMS of (data - offset), for `(fit, data)` pairs.
