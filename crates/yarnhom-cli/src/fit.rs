@@ -220,7 +220,9 @@ fn print_errors(grid: &Grid, spline: &Spline, symmetrized_shear: bool) {
         if symmetrized_shear { "; symmetrized in sa, Sec. 4.1" } else { "" }
     );
     for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2, symmetrized_shear) {
-        let modelled = e.relative_rms_modelled.map_or("-".to_string(), |r| format!("{:6.2}%", 100.0 * r));
+        let modelled = e
+            .relative_rms_modelled
+            .map_or("-".to_string(), |r| format!("{:6.2}% ({} samples)", 100.0 * r, e.samples_modelled));
         println!(
             "  {:8} {:5} samples  {:6.2}%  {:6.2}%  {modelled}",
             e.term,

@@ -348,6 +348,8 @@ pub struct TermError {
     /// responds differently to the two senses of shear, and the fit represents their mean);
     /// `None` when no such samples remain.
     pub relative_rms_modelled: Option<f64>,
+    /// Number of samples in `relative_rms_modelled`.
+    pub samples_modelled: usize,
 }
 
 /// The fit's error on each term of its grid; `symmetrized_shear` as the fit's
@@ -370,9 +372,8 @@ pub fn fit_errors(
             let shear_axis = term.axes.iter().position(|&a| a as usize == SHEAR);
             let modelled_energy = |s: &GridSample| match shear_axis {
                 Some(k) if symmetrized_shear => {
-                    let mut mirror = s.index;
-                    mirror[k] = mirror_index(&term.values[k], s.index[k] as usize)? as u32;
-                    Some(symexp(0.5 * (symlog(s.energy_density_j_m2?) + symlog(energy(mirror)?))))
+                    let mirrored = mirrored_symlog_energy(&term.values[k], s.index, k, &energy)?;
+                    Some(symexp(0.5 * (symlog(s.energy_density_j_m2?) + mirrored)))
                 }
                 _ => s.energy_density_j_m2,
             };
@@ -397,16 +398,35 @@ pub fn fit_errors(
                 relative_rms: relative_rms(&all, 0.0),
                 relative_rms_deformation: relative_rms(&all, f0),
                 relative_rms_modelled: (!modelled.is_empty()).then(|| relative_rms(&modelled, 0.0)),
+                samples_modelled: modelled.len(),
             }
         })
         .collect()
 }
 
-/// The index of the value `-values[i]` among `values` (an axis sampled symmetrically about 0),
-/// if there is one.
-fn mirror_index(values: &[f64], i: usize) -> Option<usize> {
-    let scale = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    values.iter().position(|v| (v + values[i]).abs() <= 1e-9 * scale)
+/// `symlog Ψ` at the mirror image of the sample at `index` along axis `k` (values `values`):
+/// the sampled axis value `-values[index[k]]`, or the linear interpolation in symlog space
+/// between the two sampled values around it (a symmetric range sampled at an even count has
+/// no exact mirror); `None` beyond the sampled range or next to a sample that did not converge.
+fn mirrored_symlog_energy(
+    values: &[f64],
+    index: [u32; 2],
+    k: usize,
+    energy: &dyn Fn([u32; 2]) -> Option<f64>,
+) -> Option<f64> {
+    let target = -values[index[k] as usize];
+    let at = |j: usize| {
+        let mut i = index;
+        i[k] = j as u32;
+        energy(i).map(symlog)
+    };
+    let upper = values.iter().position(|&v| v >= target)?;
+    if values[upper] == target {
+        return at(upper);
+    }
+    let lower = upper.checked_sub(1)?;
+    let t = (target - values[lower]) / (values[upper] - values[lower]);
+    Some((1.0 - t) * at(lower)? + t * at(upper)?)
 }
 
 /// RMS of (fit - data) over RMS of (data - offset), for `(fit, data)` pairs.
@@ -433,6 +453,21 @@ mod tests {
         assert!(dropped > 0);
         assert_eq!(restricted.samples.len() + dropped, grid.samples.len());
         assert_eq!(restrict_grid(&grid, &[]), grid);
+    }
+
+    #[test]
+    fn the_mirror_of_a_sample_is_interpolated_in_symlog_space_between_its_neighbours() {
+        // An axis sampled at an even count: 0.4 has no mirror, -0.4 lies between -0.5 and 0.
+        let values = [-1.0, -0.5, 0.0, 0.4, 1.0];
+        let symlog_energy = |sa: f64| 2.0 + sa;
+        let energy = |i: [u32; 2]| (i[1] != 9).then(|| symexp(symlog_energy(values[i[0] as usize])));
+        let mirrored = |i: u32| mirrored_symlog_energy(&values, [i, 0], 0, &energy);
+        assert_eq!(mirrored(4), Some(symlog_energy(-1.0)));
+        assert_eq!(mirrored(2), Some(symlog_energy(0.0)));
+        let at_minus_04 = mirrored(3).expect("within the range");
+        assert!((at_minus_04 - symlog_energy(-0.4)).abs() < 1e-12, "{at_minus_04}");
+        assert_eq!(mirrored_symlog_energy(&[-0.5, 0.0, 1.0], [2, 0], 0, &energy), None, "beyond the range");
+        assert_eq!(mirrored_symlog_energy(&values, [3, 9], 0, &energy), None, "a neighbour failed");
     }
 
     #[test]
