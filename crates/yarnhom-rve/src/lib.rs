@@ -10,7 +10,9 @@
 //! - [`model`]: the tile's elements and rest state, built from a pattern and a yarn model;
 //! - [`placement`]: where vertex instances go under a macro strain;
 //! - [`assembly`]: energy, gradient and Hessian over `g`;
-//! - [`broadphase`]: the uniform-grid search for edge pairs within contact reach;
+//! - [`broadphase`]: the uniform-grid search for edge pairs within contact reach, among the pairs
+//!   that are near each other in the fabric ([`RveModel::can_touch`]: a tile bent round onto
+//!   itself does not collide with itself);
 //! - [`ccd`]: additive continuous collision detection for collision-safe steps (A.2.3);
 //! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
