@@ -4,6 +4,8 @@
 //! interpolation (Fritsch-Carlson; App. B), increasing extrapolation (A.3.5) and residualization
 //! (A.37, A.38).
 
+use std::collections::HashMap;
+
 use yarnhom_artifacts::grid::strain_values;
 use yarnhom_artifacts::{
     AxisLimit, BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
@@ -366,9 +368,9 @@ pub fn fit_errors(
         .map(|(t, term)| {
             let samples: Vec<&GridSample> =
                 grid.samples.iter().filter(|s| s.term as usize == t && s.converged).collect();
-            let energy = |index: [u32; 2]| {
-                samples.iter().find(|s| s.index == index).and_then(|s| s.energy_density_j_m2)
-            };
+            let by_index: HashMap<[u32; 2], f64> =
+                samples.iter().filter_map(|s| Some((s.index, s.energy_density_j_m2?))).collect();
+            let energy = |index: [u32; 2]| by_index.get(&index).copied();
             let shear_axis = term.axes.iter().position(|&a| a as usize == SHEAR);
             let modelled_energy = |s: &GridSample| match shear_axis {
                 Some(k) if symmetrized_shear => {
