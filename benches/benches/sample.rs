@@ -7,14 +7,14 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_rve::RveModel;
-use yarnhom_rve::sample::{SampleOptions, SamplePlan, SampleRanges, sample_lines};
+use yarnhom_rve::sample::{PlanRanges, SampleOptions, SamplePlan, sample_lines};
 
 fn bench_sweep(c: &mut Criterion) {
     let path = format!("{}/../../shared/data/hylc-patterns/stock.pyp", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
     let pattern = parse_pyp(&text, "stock", None).expect("published pattern");
     let model = RveModel::new(&pattern, &YarnModel::table_4_1("stock").expect("row")).expect("tile");
-    let mut plan = SamplePlan::thesis(&SampleRanges::default(), 9, 3).expect("plan");
+    let mut plan = SamplePlan::thesis(&PlanRanges::default(), 9, 3).expect("plan");
     plan.terms.retain(|t| t.axes.len() == 1);
     let lines = plan.lines();
     let options = SampleOptions::default();

@@ -81,17 +81,27 @@ pub struct GridFitArgs {
 /// `AXIS=MIN:MAX` with `MIN <= 0 <= MAX`.
 fn parse_limit(text: &str) -> Result<AxisLimit, String> {
     let (name, range) = text.split_once('=').ok_or("expected AXIS=MIN:MAX, e.g. kx=-160:160")?;
-    let axis = AXIS_NAMES
-        .iter()
-        .position(|&a| a == name)
-        .ok_or_else(|| format!("unknown axis '{name}' (axes: {})", AXIS_NAMES.join(", ")))?;
-    let (min, max) = range.split_once(':').ok_or("expected MIN:MAX after the axis")?;
-    let number = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("'{v}': {e}"));
-    let (min, max) = (number(min)?, number(max)?);
+    let axis = parse_axis(name)?;
+    let [min, max] = parse_interval(range)?;
     if !(min <= 0.0 && max >= 0.0) {
         return Err(format!("the limits must contain 0 (the rest state), got {min}:{max}"));
     }
     Ok(AxisLimit { axis: axis as u8, min, max })
+}
+
+/// The index of a strain parameter by its name (`sx`, `sa`, `sy`, `kx`, `ky`).
+pub(crate) fn parse_axis(name: &str) -> Result<usize, String> {
+    AXIS_NAMES
+        .iter()
+        .position(|&a| a == name.trim())
+        .ok_or_else(|| format!("unknown axis '{name}' (axes: {})", AXIS_NAMES.join(", ")))
+}
+
+/// `MIN:MAX` as two numbers.
+pub(crate) fn parse_interval(text: &str) -> Result<[f64; 2], String> {
+    let (min, max) = text.split_once(':').ok_or_else(|| format!("expected MIN:MAX, got '{text}'"))?;
+    let number = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("'{v}': {e}"));
+    Ok([number(min)?, number(max)?])
 }
 
 #[derive(Debug, Args)]

@@ -17,11 +17,13 @@ use yarnhom_artifacts::container;
 use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard, GridTerm, strain_from_values};
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
-    LineResult, SampleOptions, SampleOutcome, SamplePlan, SampleRanges, SweepLine, sample_lines, shard_lines,
+    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SweepLine, sample_lines,
+    shard_lines,
 };
 use yarnhom_trace::{RveSample, TraceError, TraceMetadata};
 
 use crate::Outcome;
+use crate::fit::{parse_axis, parse_interval};
 use crate::inputs::{base_name, provenance};
 use crate::rve::{load_pattern_and_model, stop_reason};
 use crate::trace_out::{TraceSink, is_stdout, yarns_in_order};
@@ -39,6 +41,14 @@ pub struct SampleArgs {
     /// Samples per axis of each 2D term (the thesis: 50, i.e. 50 x 50).
     #[arg(long, default_value_t = 50)]
     pub n2d: usize,
+    /// Sample a 1D term over another range, e.g. `--range sx=-0.3:0.8` (repeatable; 0 must lie
+    /// strictly inside). Default: the published stockinette's ranges (README, "Sampling").
+    #[arg(long = "range", value_name = "AXIS=MIN:MAX", value_parser = parse_range)]
+    pub ranges: Vec<(usize, [f64; 2])>,
+    /// Sample a 2D term over other ranges, e.g. `--plane-range sa,ky=-0.6:0.6,-184:184`
+    /// (repeatable; the thesis samples each plane over its own ranges, Alg. 6).
+    #[arg(long = "plane-range", value_name = "A,B=MIN:MAX,MIN:MAX", value_parser = parse_plane_range)]
+    pub plane_ranges: Vec<PlaneRange>,
     /// Compute this shard `K/N` of the sweep lines only (0 <= K < N); merge the shards with
     /// `yarnhom grid merge`.
     #[arg(long, value_name = "K/N")]
@@ -70,10 +80,47 @@ struct RunKey {
     model: String,
     n1d: usize,
     n2d: usize,
+    /// `[lower, upper]` of each axis of each term, in plan order.
+    ranges: Vec<[f64; 2]>,
     shard: Option<(u32, u32)>,
     geometry: bool,
     stress: bool,
     max_iterations: usize,
+}
+
+/// `AXIS=MIN:MAX`.
+fn parse_range(text: &str) -> Result<(usize, [f64; 2]), String> {
+    let (name, range) = text.split_once('=').ok_or("expected AXIS=MIN:MAX, e.g. sx=-0.3:0.8")?;
+    Ok((parse_axis(name)?, parse_interval(range)?))
+}
+
+/// `A,B=MIN:MAX,MIN:MAX`, the axes in either order.
+fn parse_plane_range(text: &str) -> Result<PlaneRange, String> {
+    let expected = "expected A,B=MIN:MAX,MIN:MAX, e.g. sa,ky=-0.6:0.6,-184:184";
+    let (names, ranges) = text.split_once('=').ok_or(expected)?;
+    let ((a, b), (ra, rb)) = names.split_once(',').zip(ranges.split_once(',')).ok_or(expected)?;
+    let (a, b, ra, rb) = (parse_axis(a)?, parse_axis(b)?, parse_interval(ra)?, parse_interval(rb)?);
+    match a.cmp(&b) {
+        std::cmp::Ordering::Less => Ok(PlaneRange { axes: [a, b], ranges: [ra, rb] }),
+        std::cmp::Ordering::Greater => Ok(PlaneRange { axes: [b, a], ranges: [rb, ra] }),
+        std::cmp::Ordering::Equal => Err(format!("a 2D term needs two different axes, got '{names}'")),
+    }
+}
+
+/// The published stockinette's ranges with the command line's `--range` and `--plane-range`.
+fn plan_ranges(args: &SampleArgs) -> anyhow::Result<PlanRanges> {
+    let mut ranges = PlanRanges::default();
+    for &(axis, [lower, upper]) in &args.ranges {
+        (ranges.single.lower[axis], ranges.single.upper[axis]) = (lower, upper);
+    }
+    for plane in &args.plane_ranges {
+        let [a, b] = plane.axes.map(|axis| AXIS_NAMES[axis]);
+        let slot = ranges.plane_mut(plane.axes).with_context(|| {
+            format!("--plane-range {a},{b}: not a sampled 2D term (kx and ky are never sampled together)")
+        })?;
+        *slot = *plane;
+    }
+    Ok(PlanRanges::new(ranges.single, ranges.planes)?)
 }
 
 /// One finished sweep line in the checkpoint.
@@ -86,13 +133,14 @@ struct CheckpointLine {
 pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     let (pattern, model, inputs) = load_pattern_and_model(&args.pattern, &args.model)?;
     let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
-    let plan = SamplePlan::thesis(&SampleRanges::default(), args.n1d, args.n2d)?;
+    let plan = SamplePlan::thesis(&plan_ranges(&args)?, args.n1d, args.n2d)?;
     let shard = args.shard.as_deref().map(parse_shard).transpose()?;
     let key = RunKey {
         pattern_hash: inputs[0].content_hash.clone(),
         model: model.name.clone(),
         n1d: args.n1d,
         n2d: args.n2d,
+        ranges: plan.terms.iter().flat_map(|t| t.values.iter().map(|v| [v[0], v[v.len() - 1]])).collect(),
         shard: shard.map(|s| (s.index, s.count)),
         geometry: args.geometry,
         stress: !args.no_stress,

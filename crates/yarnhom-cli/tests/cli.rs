@@ -403,6 +403,36 @@ fn rve_sample_shards_merge_into_the_unsharded_grid_and_a_killed_run_resumes() {
 }
 
 #[test]
+fn rve_sample_takes_its_1d_and_2d_ranges_from_the_command_line() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tiny = format!("{DATA}/stocktiniest.pyp");
+    let base = ["rve", "sample", &tiny, "--model", "table4.1:stock-small", "--n1d", "3", "--n2d", "3"];
+    let with = |extra: &[&'static str]| [&base[..], extra].concat();
+    ok(
+        &with(&["--range", "sx=-0.2:0.4", "--plane-range", "ky,sa=-40:40,-0.3:0.3", "-o", "r.grid.yh"]),
+        dir.path(),
+    );
+    let (_, grid) = container::read::<yarnhom_artifacts::Grid>(&dir.path().join("r.grid.yh")).expect("grid");
+    assert_eq!(grid.terms[0].axes, [0]);
+    assert_eq!(grid.terms[0].values[0], [-0.2, 0.0, 0.4]);
+    let sa_ky = grid.terms.iter().find(|t| t.axes == [1, 4]).expect("sa,ky");
+    assert_eq!(sa_ky.values, [vec![-0.3, 0.0, 0.3], vec![-40.0, 0.0, 40.0]], "axes put in order");
+    let sx_sa = grid.terms.iter().find(|t| t.axes == [0, 1]).expect("sx,sa");
+    assert_eq!(sx_sa.values, [vec![-0.1, 0.0, 0.67], vec![-0.6, 0.0, 0.6]], "the published stockinette's");
+    fails_with(&with(&["--range", "sa=-0.5:1"]), dir.path(), "|sa| < 1");
+    fails_with(&with(&["--range", "kx=10:200"]), dir.path(), "0 strictly inside");
+    fails_with(&with(&["--plane-range", "kx,ky=-1:1,-1:1"]), dir.path(), "never sampled together");
+    for (args, problem) in [
+        (with(&["--plane-range", "sa=-0.3:0.3"]), "expected A,B=MIN:MAX,MIN:MAX"),
+        (with(&["--range", "sz=-1:1"]), "unknown axis 'sz'"),
+    ] {
+        let o = yarnhom(&args, dir.path());
+        assert_eq!(o.status.code(), Some(2), "a usage error");
+        assert!(stderr(&o).contains(problem), "{}", stderr(&o));
+    }
+}
+
+#[test]
 fn fit_writes_a_spline_that_reproduces_its_grid_and_plots_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let grid = dir.path().join("synthetic.grid.yh");

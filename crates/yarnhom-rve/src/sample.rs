@@ -35,7 +35,10 @@ const COMPRESSION_RATE: f64 = 3.0;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SampleError {
     /// A range does not contain 0 strictly inside, is not finite, or leaves the valid strains.
-    #[error("invalid range [{lower}, {upper}] for {name}")]
+    #[error(
+        "invalid range [{lower}, {upper}] for {name}: a range must be finite with 0 strictly inside, \
+         and sx, sy > -1, |sa| < 1 (4.1)"
+    )]
     Range {
         /// The parameter.
         name: &'static str,
@@ -47,6 +50,24 @@ pub enum SampleError {
     /// An axis needs at least 3 values: both ends and 0.
     #[error("an axis needs at least 3 values, got {0}")]
     TooFewValues(usize),
+    /// The 2D ranges are not one per term of [`plane_axes`], in its order.
+    #[error("2D ranges given for {0:?}, expected one per term of {expected:?}", expected = plane_axes())]
+    Planes(Vec<[usize; 2]>),
+}
+
+/// Check one sampled range: finite, `lower < 0 < upper`, `sx, sy > -1` and `|sa| < 1` (4.1).
+fn check_range(axis: usize, lower: f64, upper: f64) -> Result<(), SampleError> {
+    let valid = lower.is_finite() && upper.is_finite() && lower < 0.0 && upper > 0.0;
+    let strain_valid = match axis {
+        0 | 2 => lower > -1.0,
+        1 => lower > -1.0 && upper < 1.0,
+        _ => true,
+    };
+    if valid && strain_valid {
+        Ok(())
+    } else {
+        Err(SampleError::Range { name: PARAMETERS[axis], lower, upper })
+    }
 }
 
 /// The sampled range of each strain parameter `(sx, sa, sy, kx, ky)` (`kx`, `ky` in 1/m).
@@ -59,29 +80,89 @@ pub struct SampleRanges {
 }
 
 impl SampleRanges {
-    /// Validated ranges: finite, `lower < 0 < upper`, `sx, sy > -1` and `|sa| < 1` (4.1).
+    /// Validated ranges (see [`check_range`]).
     pub fn new(lower: [f64; 5], upper: [f64; 5]) -> Result<Self, SampleError> {
-        for (k, name) in PARAMETERS.into_iter().enumerate() {
-            let (l, u) = (lower[k], upper[k]);
-            let valid = l.is_finite() && u.is_finite() && l < 0.0 && u > 0.0;
-            let strain_valid = match k {
-                0 | 2 => l > -1.0,
-                1 => l > -1.0 && u < 1.0,
-                _ => true,
-            };
-            if !(valid && strain_valid) {
-                return Err(SampleError::Range { name, lower: l, upper: u });
-            }
-        }
+        (0..5).try_for_each(|k| check_range(k, lower[k], upper[k]))?;
         Ok(SampleRanges { lower, upper })
     }
 }
 
 impl Default for SampleRanges {
-    /// The ranges of the published HYLC stockinette fit, whose strain scale (the largest
-    /// absolute value of each parameter, Sec. 4.1.1) is `(0.8, 0.75, 0.8, 200, 230)`.
+    /// The 1D ranges of the published HYLC stockinette fit (`stock1.json`): its 1D control
+    /// points span 0.95 of the sampled range (Alg. 4), so the range is their extent / 0.95.
     fn default() -> Self {
-        SampleRanges { lower: [-0.3, -0.75, -0.3, -200.0, -230.0], upper: [0.8, 0.75, 0.8, 200.0, 230.0] }
+        SampleRanges { lower: [-0.52, -0.75, -0.52, -200.0, -230.0], upper: [0.78, 0.75, 0.78, 200.0, 230.0] }
+    }
+}
+
+/// The sampled ranges of one 2D term (Alg. 6 takes "2D-sampling ranges" per pair, apart from
+/// the 1D ones).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlaneRange {
+    /// The two axes, ascending, not `(kx, ky)`.
+    pub axes: [usize; 2],
+    /// `[lower, upper]` of each axis.
+    pub ranges: [[f64; 2]; 2],
+}
+
+/// The sampled ranges of the whole plan: Alg. 6's 1D ranges and the ranges of each of the
+/// nine 2D terms.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanRanges {
+    /// The ranges of the 1D terms.
+    pub single: SampleRanges,
+    /// The ranges of the 2D terms, one per pair of [`plane_axes`], in that order.
+    pub planes: Vec<PlaneRange>,
+}
+
+/// The published stockinette's 2D ranges, recovered from `stock1.json`: each patch's control
+/// points span 0.9 of its sampled ranges, and 0.3 for the stockinette's bending terms (Alg. 5,
+/// Sec. 4.3), so a range is the patch's extent divided by that span. Every recovered value is
+/// round, and each strain gets the same range in every plane whose partner is of one kind.
+const STOCKINETTE_PLANES: [PlaneRange; 9] = [
+    PlaneRange { axes: [0, 1], ranges: [[-0.1, 0.67], [-0.6, 0.6]] },
+    PlaneRange { axes: [0, 2], ranges: [[-0.37, 0.8], [-0.37, 0.8]] },
+    PlaneRange { axes: [0, 3], ranges: [[-0.1, 0.67], [-144.0, 144.0]] },
+    PlaneRange { axes: [0, 4], ranges: [[-0.1, 0.67], [-184.0, 184.0]] },
+    PlaneRange { axes: [1, 2], ranges: [[-0.6, 0.6], [-0.1, 0.67]] },
+    PlaneRange { axes: [1, 3], ranges: [[-0.6, 0.6], [-160.0, 160.0]] },
+    PlaneRange { axes: [1, 4], ranges: [[-0.6, 0.6], [-184.0, 184.0]] },
+    PlaneRange { axes: [2, 3], ranges: [[-0.1, 0.67], [-160.0, 160.0]] },
+    PlaneRange { axes: [2, 4], ranges: [[-0.1, 0.67], [-165.6, 165.6]] },
+];
+
+/// The nine 2D terms of (4.2): all pairs of `(sx, sa, sy, kx, ky)` but `(kx, ky)`, ascending.
+pub fn plane_axes() -> Vec<[usize; 2]> {
+    (0..5).flat_map(|a| (a + 1..5).map(move |b| [a, b])).filter(|axes| *axes != BENDING).collect()
+}
+
+impl PlanRanges {
+    /// Validated ranges: every 1D and 2D range valid, and one plane per pair of
+    /// [`plane_axes`], in that order.
+    pub fn new(single: SampleRanges, planes: Vec<PlaneRange>) -> Result<Self, SampleError> {
+        let single = SampleRanges::new(single.lower, single.upper)?;
+        let axes: Vec<[usize; 2]> = planes.iter().map(|p| p.axes).collect();
+        if axes != plane_axes() {
+            return Err(SampleError::Planes(axes));
+        }
+        for plane in &planes {
+            for (&axis, [lower, upper]) in plane.axes.iter().zip(plane.ranges) {
+                check_range(axis, lower, upper)?;
+            }
+        }
+        Ok(PlanRanges { single, planes })
+    }
+
+    /// The plane of `axes`, if it is one of [`plane_axes`].
+    pub fn plane_mut(&mut self, axes: [usize; 2]) -> Option<&mut PlaneRange> {
+        self.planes.iter_mut().find(|p| p.axes == axes)
+    }
+}
+
+impl Default for PlanRanges {
+    /// The published stockinette's ranges ([`SampleRanges::default`], [`STOCKINETTE_PLANES`]).
+    fn default() -> Self {
+        PlanRanges { single: SampleRanges::default(), planes: STOCKINETTE_PLANES.to_vec() }
     }
 }
 
@@ -161,10 +242,14 @@ pub struct PlanTerm {
 }
 
 impl PlanTerm {
-    /// The term of `axes` with [`axis_values`] of `n` values each over `ranges`.
-    fn new(ranges: &SampleRanges, axes: Vec<usize>, n: usize) -> Self {
-        let values =
-            axes.iter().map(|&a| axis_values(ranges.lower[a], ranges.upper[a], n, AxisKind::of(a))).collect();
+    /// The term of `axes` with [`axis_values`] of `n` values each over `ranges` (`[lower,
+    /// upper]` of each axis).
+    fn new(axes: Vec<usize>, ranges: &[[f64; 2]], n: usize) -> Self {
+        let values = axes
+            .iter()
+            .zip(ranges)
+            .map(|(&a, &[lower, upper])| axis_values(lower, upper, n, AxisKind::of(a)))
+            .collect();
         PlanTerm { axes, values }
     }
 
@@ -198,18 +283,17 @@ pub struct SamplePlan {
 }
 
 impl SamplePlan {
-    /// The thesis's plan (App. A.3.1): the five 1D terms with `n_1d` values each (thesis: 150)
-    /// and the nine 2D terms of all pairs but `(kx, ky)` on `n_2d × n_2d` grids (thesis: 50).
-    pub fn thesis(ranges: &SampleRanges, n_1d: usize, n_2d: usize) -> Result<Self, SampleError> {
-        let ranges = SampleRanges::new(ranges.lower, ranges.upper)?;
+    /// The thesis's plan (App. A.3.1, Alg. 6): the five 1D terms with `n_1d` values each
+    /// (thesis: 150) over `ranges.single` and the nine 2D terms of [`plane_axes`] on
+    /// `n_2d × n_2d` grids (thesis: 50) over their `ranges.planes`.
+    pub fn thesis(ranges: &PlanRanges, n_1d: usize, n_2d: usize) -> Result<Self, SampleError> {
+        let ranges = PlanRanges::new(ranges.single, ranges.planes.clone())?;
         if let Some(&n) = [n_1d, n_2d].iter().find(|&&n| n < 3) {
             return Err(SampleError::TooFewValues(n));
         }
-        let singles = (0..5).map(|a| PlanTerm::new(&ranges, vec![a], n_1d));
-        let pairs = (0..5)
-            .flat_map(|a| (a + 1..5).map(move |b| vec![a, b]))
-            .filter(|axes| axes[..] != BENDING)
-            .map(|axes| PlanTerm::new(&ranges, axes, n_2d));
+        let single = ranges.single;
+        let singles = (0..5).map(|a| PlanTerm::new(vec![a], &[[single.lower[a], single.upper[a]]], n_1d));
+        let pairs = ranges.planes.iter().map(|p| PlanTerm::new(p.axes.to_vec(), &p.ranges, n_2d));
         Ok(SamplePlan { terms: singles.chain(pairs).collect() })
     }
 

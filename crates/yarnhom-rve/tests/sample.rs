@@ -3,11 +3,11 @@
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
+use yarnhom_artifacts::{YarnModel, arcsim::read_spline, pyp::parse_pyp};
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
-    AxisKind, LineResult, SampleError, SampleOptions, SamplePlan, SampleRanges, SweepLine, axis_values,
-    sample_lines, shard_lines,
+    AxisKind, LineResult, PlanRanges, SampleError, SampleOptions, SamplePlan, SampleRanges, SweepLine,
+    axis_values, plane_axes, sample_lines, shard_lines,
 };
 
 fn stocktiniest() -> RveModel {
@@ -27,7 +27,7 @@ fn ranges_must_contain_zero_and_stay_valid_strains() {
     let d = SampleRanges::default();
     assert_eq!(SampleRanges::new(d.lower, d.upper), Ok(d));
     let scale: Vec<f64> = d.lower.iter().zip(d.upper).map(|(l, u)| l.abs().max(u)).collect();
-    assert_eq!(scale, [0.8, 0.75, 0.8, 200.0, 230.0], "strain scale of the HYLC stock fit");
+    assert_eq!(scale, [0.78, 0.75, 0.78, 200.0, 230.0], "the published stockinette's 1D ranges");
     let broken = |k: usize, lower: f64, upper: f64| {
         let (mut l, mut u) = (d.lower, d.upper);
         (l[k], u[k]) = (lower, upper);
@@ -40,6 +40,57 @@ fn ranges_must_contain_zero_and_stay_valid_strains() {
     assert!(broken(1, -0.5, 1.0), "|sa| < 1");
     assert!(broken(4, -1.0, f64::INFINITY), "finite");
     assert!(broken(4, f64::NAN, 1.0), "finite");
+}
+
+/// The published fits place their control points over a fixed share ("span") of the sampled
+/// range: 0.95 for 1D terms (Alg. 4), 0.9 for 2D terms (Alg. 5) and 0.3 for the stockinette's
+/// bending terms (Sec. 4.3). The default ranges are those that give `stock1.json`'s knots.
+#[test]
+fn the_default_ranges_are_those_of_the_published_stockinette_fit() {
+    let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
+    let published = read_spline(std::path::Path::new(&path)).expect("stock1.json");
+    let extent = |knots: &[f64], axis: u8, span: f64| {
+        let scale = published.strain_scale[axis as usize];
+        [knots[0] * scale / span, knots[knots.len() - 1] * scale / span]
+    };
+    let close = |a: [f64; 2], b: [f64; 2]| {
+        (a[0] - b[0]).abs() <= 1e-9 * b[0].abs() && (a[1] - b[1]).abs() <= 1e-9 * b[1]
+    };
+    let ranges = PlanRanges::default();
+    for term in &published.terms_1d {
+        let a = term.axis as usize;
+        let ours = [ranges.single.lower[a], ranges.single.upper[a]];
+        assert!(close(extent(&term.knots, term.axis, 0.95), ours), "1D {a}: {ours:?}");
+    }
+    assert_eq!(published.terms_2d.len(), 9);
+    for term in &published.terms_2d {
+        let axes = term.axes.map(usize::from);
+        let plane = ranges.planes.iter().find(|p| p.axes == axes).expect("plane");
+        let span = if axes[1] >= 3 { 0.3 } else { 0.9 };
+        assert!(close(extent(&term.u_knots, term.axes[0], span), plane.ranges[0]), "{axes:?}: {plane:?}");
+        assert!(close(extent(&term.v_knots, term.axes[1], span), plane.ranges[1]), "{axes:?}: {plane:?}");
+    }
+}
+
+#[test]
+fn plan_ranges_need_every_plane_once_and_valid() {
+    let d = PlanRanges::default();
+    assert_eq!(PlanRanges::new(d.single, d.planes.clone()), Ok(d.clone()));
+    assert_eq!(d.planes.iter().map(|p| p.axes).collect::<Vec<_>>(), plane_axes());
+    let mut missing = d.planes.clone();
+    missing.pop();
+    assert!(matches!(PlanRanges::new(d.single, missing), Err(SampleError::Planes(_))));
+    let mut swapped = d.planes.clone();
+    swapped.swap(0, 1);
+    assert!(matches!(PlanRanges::new(d.single, swapped), Err(SampleError::Planes(_))));
+    let mut outside = d.clone();
+    outside.plane_mut([1, 4]).expect("sa,ky").ranges[0] = [-0.6, 1.0];
+    assert!(matches!(
+        PlanRanges::new(outside.single, outside.planes),
+        Err(SampleError::Range { name: "sa", .. })
+    ));
+    let mut d = d;
+    assert!(d.plane_mut([3, 4]).is_none(), "kx and ky are never sampled together");
 }
 
 #[test]
@@ -96,7 +147,8 @@ fn stretch_axes_are_densest_towards_compression() {
 
 #[test]
 fn the_thesis_plan_has_five_1d_and_nine_2d_terms_without_kx_ky() {
-    let plan = SamplePlan::thesis(&SampleRanges::default(), 150, 50).expect("plan");
+    let ranges = PlanRanges::default();
+    let plan = SamplePlan::thesis(&ranges, 150, 50).expect("plan");
     assert_eq!(plan.sample_count(), 750 + 22500, "App. A.3.1");
     let axes: Vec<Vec<usize>> = plan.terms.iter().map(|t| t.axes.clone()).collect();
     assert_eq!(&axes[..5], &[vec![0], vec![1], vec![2], vec![3], vec![4]]);
@@ -104,19 +156,23 @@ fn the_thesis_plan_has_five_1d_and_nine_2d_terms_without_kx_ky() {
     assert!(!axes.contains(&vec![3, 4]), "bending along one direction at a time (Sec. 4.1.1)");
     assert!(axes[5..].iter().all(|a| a.len() == 2 && a[0] < a[1]));
     assert_eq!(axes[5..].iter().collect::<HashSet<_>>().len(), 9);
-    for term in &plan.terms {
+    for term in &plan.terms[..5] {
+        let (axis, r) = (term.axes[0], ranges.single);
+        assert_eq!(term.values[0], axis_values(r.lower[axis], r.upper[axis], 150, AxisKind::of(axis)));
+    }
+    for (term, plane) in plan.terms[5..].iter().zip(&ranges.planes) {
+        assert_eq!(term.axes, plane.axes, "the 2D terms in the order of their ranges");
         for (slot, &axis) in term.axes.iter().enumerate() {
-            let n = if term.axes.len() == 1 { 150 } else { 50 };
-            let r = SampleRanges::default();
-            assert_eq!(term.values[slot], axis_values(r.lower[axis], r.upper[axis], n, AxisKind::of(axis)));
+            let [lower, upper] = plane.ranges[slot];
+            assert_eq!(term.values[slot], axis_values(lower, upper, 50, AxisKind::of(axis)));
         }
     }
-    assert_eq!(SamplePlan::thesis(&SampleRanges::default(), 2, 50), Err(SampleError::TooFewValues(2)));
+    assert_eq!(SamplePlan::thesis(&ranges, 2, 50), Err(SampleError::TooFewValues(2)));
 }
 
 #[test]
 fn lines_walk_outward_from_the_origin_and_cover_every_sample_once() {
-    let plan = SamplePlan::thesis(&SampleRanges::default(), 9, 6).expect("plan");
+    let plan = SamplePlan::thesis(&PlanRanges::default(), 9, 6).expect("plan");
     let lines = plan.lines();
     assert_eq!(lines, plan.lines(), "deterministic");
     assert_eq!(lines.len(), 5 * 2 + 9 * 6 * 2);
@@ -142,7 +198,7 @@ fn lines_walk_outward_from_the_origin_and_cover_every_sample_once() {
 
 #[test]
 fn shards_deal_every_line_exactly_once() {
-    let lines = SamplePlan::thesis(&SampleRanges::default(), 9, 5).expect("plan").lines();
+    let lines = SamplePlan::thesis(&PlanRanges::default(), 9, 5).expect("plan").lines();
     for count in [1, 2, 3, 7, 200] {
         let mut union: Vec<SweepLine> = (0..count).flat_map(|i| shard_lines(&lines, i, count)).collect();
         union.sort_by_key(|l| l.index);
@@ -152,7 +208,7 @@ fn shards_deal_every_line_exactly_once() {
 
 /// A plan of a few small terms: sx and kx alone, and the (sx, sa) grid.
 fn tiny_plan() -> SamplePlan {
-    let mut plan = SamplePlan::thesis(&SampleRanges::default(), 5, 3).expect("plan");
+    let mut plan = SamplePlan::thesis(&PlanRanges::default(), 5, 3).expect("plan");
     plan.terms = [0, 3, 5].into_iter().map(|t| plan.terms[t].clone()).collect();
     assert_eq!(plan.terms[2].axes, [0, 1]);
     plan
@@ -216,7 +272,7 @@ fn sweeps_are_identical_for_any_thread_count_and_sharding() {
 #[ignore = "timing"]
 fn timing_of_a_9_by_5_plan() {
     let model = stocktiniest();
-    let plan = SamplePlan::thesis(&SampleRanges::default(), 9, 5).expect("plan");
+    let plan = SamplePlan::thesis(&PlanRanges::default(), 9, 5).expect("plan");
     let lines = plan.lines();
     let started = std::time::Instant::now();
     let results = sample_lines(&model, &plan, &lines, &SampleOptions::default(), &|_| {});
