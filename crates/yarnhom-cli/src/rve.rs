@@ -35,8 +35,11 @@ pub enum RveCommand {
     Relax(RelaxArgs),
     /// Sample the homogenized energy (and stress) over the plan of App. A.3.1 into a `grid`
     /// artifact: five 1D terms of N1D samples and nine 2D terms of N2D x N2D (all pairs of
-    /// sx, sa, sy, kx, ky but kx-ky), non-uniformly spaced, each sweep line warm-started outward
-    /// from zero strain, lines in parallel on all cores (RAYON_NUM_THREADS to limit).
+    /// sx, sa, sy, kx, ky but kx-ky), each term over its own ranges (Alg. 6; default the
+    /// published stockinette's: 1D sx, sy -0.52..0.78, sa ±0.75, kx ±200, ky ±230 1/m; in the
+    /// planes sx, sy -0.1..0.67 (-0.37..0.8 in sx,sy), sa ±0.6, kx ±144..160, ky ±166..184),
+    /// non-uniformly spaced, each sweep line warm-started outward from zero strain, lines in
+    /// parallel on all cores (RAYON_NUM_THREADS to limit).
     ///
     /// Resumable: every finished line is appended to OUTPUT.checkpoint, and a rerun with the
     /// same arguments continues from it. `--shard K/N` computes one of N disjoint sets of lines
