@@ -9,6 +9,7 @@ use yarnhom_artifacts::arcsim::{ArcsimMaterial, read_spline};
 use yarnhom_artifacts::grid::AXIS_NAMES;
 use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, InputRef, Spline, container};
 use yarnhom_fit::fit::restrict_grid;
+use yarnhom_fit::ranges::STOCKINETTE_SPAN_2D_BENDING;
 use yarnhom_fit::{SplineMaterial, fit_errors, fit_grid, term_shapes};
 
 use crate::Outcome;
@@ -154,7 +155,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<Outcome> {
 fn settings(args: &GridFitArgs) -> FitSettings {
     let mut s = FitSettings::default();
     if args.stockinette {
-        s.span_2d_bending = 0.3;
+        s.span_2d_bending = STOCKINETTE_SPAN_2D_BENDING;
         s.min_slope = 0.01;
     }
     s.min_slope = args.min_slope.unwrap_or(s.min_slope);

@@ -15,15 +15,16 @@ use serde::{Deserialize, Serialize};
 use yarnhom_artifacts::Pattern;
 use yarnhom_artifacts::container;
 use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard, GridTerm, strain_from_values};
+use yarnhom_fit::sampled_ranges;
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
-    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SweepLine, sample_lines,
-    shard_lines,
+    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SampleRanges, SweepLine,
+    plane_axes, sample_lines, shard_lines,
 };
 use yarnhom_trace::{RveSample, TraceError, TraceMetadata};
 
 use crate::Outcome;
-use crate::fit::{parse_axis, parse_interval};
+use crate::fit::{load_spline, parse_axis, parse_interval};
 use crate::inputs::{base_name, provenance};
 use crate::rve::{load_pattern_and_model, stop_reason};
 use crate::trace_out::{TraceSink, is_stdout, yarns_in_order};
@@ -41,8 +42,13 @@ pub struct SampleArgs {
     /// Samples per axis of each 2D term (the thesis: 50, i.e. 50 x 50).
     #[arg(long, default_value_t = 50)]
     pub n2d: usize,
+    /// Sample over the ranges a fitted material was sampled over, recovered from its control
+    /// points: an ARCSim-HYLC JSON (e.g. `../shared/data/hylc-materials/rib1.json`) or a
+    /// `.spline.yh`. Default: the published stockinette's ranges (from `stock1.json`).
+    #[arg(long, value_name = "MATERIAL")]
+    pub ranges_from: Option<PathBuf>,
     /// Sample a 1D term over another range, e.g. `--range sx=-0.3:0.8` (repeatable; 0 must lie
-    /// strictly inside). Default: the published stockinette's ranges (README, "Sampling").
+    /// strictly inside; applied after `--ranges-from`).
     #[arg(long = "range", value_name = "AXIS=MIN:MAX", value_parser = parse_range)]
     pub ranges: Vec<(usize, [f64; 2])>,
     /// Sample a 2D term over other ranges, e.g. `--plane-range sa,ky=-0.6:0.6,-184:184`
@@ -107,9 +113,13 @@ fn parse_plane_range(text: &str) -> Result<PlaneRange, String> {
     }
 }
 
-/// The published stockinette's ranges with the command line's `--range` and `--plane-range`.
+/// The published stockinette's ranges, or those of `--ranges-from`, with the command line's
+/// `--range` and `--plane-range`.
 fn plan_ranges(args: &SampleArgs) -> anyhow::Result<PlanRanges> {
-    let mut ranges = PlanRanges::default();
+    let mut ranges = match &args.ranges_from {
+        Some(path) => ranges_of(path).with_context(|| format!("--ranges-from {}", path.display()))?,
+        None => PlanRanges::default(),
+    };
     for &(axis, [lower, upper]) in &args.ranges {
         (ranges.single.lower[axis], ranges.single.upper[axis]) = (lower, upper);
     }
@@ -121,6 +131,28 @@ fn plan_ranges(args: &SampleArgs) -> anyhow::Result<PlanRanges> {
         *slot = *plane;
     }
     Ok(PlanRanges::new(ranges.single, ranges.planes)?)
+}
+
+/// The sampled ranges of a fitted material, as a plan's.
+fn ranges_of(path: &Path) -> anyhow::Result<PlanRanges> {
+    let recovered = sampled_ranges(&load_spline(path)?)?;
+    let single = SampleRanges {
+        lower: recovered.single.map(|[lower, _]| lower),
+        upper: recovered.single.map(|[_, upper]| upper),
+    };
+    let planes = plane_axes()
+        .into_iter()
+        .map(|axes| {
+            let [a, b] = axes.map(|axis| AXIS_NAMES[axis]);
+            recovered
+                .planes
+                .iter()
+                .find(|(p, _)| p.map(usize::from) == axes)
+                .map(|&(_, ranges)| PlaneRange { axes, ranges })
+                .with_context(|| format!("the material has no 2D term {a},{b}"))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    Ok(PlanRanges::new(single, planes)?)
 }
 
 /// One finished sweep line in the checkpoint.

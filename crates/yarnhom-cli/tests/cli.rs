@@ -405,8 +405,8 @@ fn rve_sample_shards_merge_into_the_unsharded_grid_and_a_killed_run_resumes() {
 #[test]
 fn rve_sample_takes_its_1d_and_2d_ranges_from_the_command_line() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let tiny = format!("{DATA}/stocktiniest.pyp");
-    let base = ["rve", "sample", &tiny, "--model", "table4.1:stock-small", "--n1d", "3", "--n2d", "3"];
+    let tiny: &'static str = format!("{DATA}/stocktiniest.pyp").leak();
+    let base = ["rve", "sample", tiny, "--model", "table4.1:stock-small", "--n1d", "3", "--n2d", "3"];
     let with = |extra: &[&'static str]| [&base[..], extra].concat();
     ok(
         &with(&["--range", "sx=-0.2:0.4", "--plane-range", "ky,sa=-40:40,-0.3:0.3", "-o", "r.grid.yh"]),
@@ -419,6 +419,20 @@ fn rve_sample_takes_its_1d_and_2d_ranges_from_the_command_line() {
     assert_eq!(sa_ky.values, [vec![-0.3, 0.0, 0.3], vec![-40.0, 0.0, 40.0]], "axes put in order");
     let sx_sa = grid.terms.iter().find(|t| t.axes == [0, 1]).expect("sx,sa");
     assert_eq!(sx_sa.values, [vec![-0.1, 0.0, 0.67], vec![-0.6, 0.0, 0.6]], "the published stockinette's");
+    // The ranges a published material was sampled over, then one overridden.
+    let rib: &'static str = format!("{MATERIALS}/rib1.json").leak();
+    ok(&with(&["--ranges-from", rib, "--range", "kx=-50:50", "-o", "rib.grid.yh"]), dir.path());
+    let (_, grid) =
+        container::read::<yarnhom_artifacts::Grid>(&dir.path().join("rib.grid.yh")).expect("grid");
+    let ends = |axes: &[u8], slot: usize| {
+        let values = &grid.terms.iter().find(|t| t.axes == axes).expect("term").values[slot];
+        [values[0], values[values.len() - 1]]
+    };
+    let close = |a: [f64; 2], b: [f64; 2]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9 * y.abs());
+    assert!(close(ends(&[0], 0), [-0.66, 0.99]), "rib's sx: {:?}", ends(&[0], 0));
+    assert_eq!(ends(&[3], 0), [-50.0, 50.0], "--range applies after --ranges-from");
+    assert!(close(ends(&[1, 4], 0), [-0.48, 0.48]) && close(ends(&[1, 4], 1), [-64.0, 64.0]));
+    fails_with(&with(&["--ranges-from", tiny]), dir.path(), "--ranges-from");
     fails_with(&with(&["--range", "sa=-0.5:1"]), dir.path(), "|sa| < 1");
     fails_with(&with(&["--range", "kx=10:200"]), dir.path(), "0 strictly inside");
     fails_with(&with(&["--plane-range", "kx,ky=-1:1,-1:1"]), dir.path(), "never sampled together");

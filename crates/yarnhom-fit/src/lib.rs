@@ -7,6 +7,7 @@
 //! - [`march`]: quasiconvex marching (A.36) and increasing extrapolation (A.3.5).
 //! - [`residual`]: residualization (A.37, A.38).
 //! - [`shape`]: single-minimum checks of the fitted terms (A.36).
+//! - [`ranges`]: the strain ranges a fitted material was sampled over, from its control points.
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
 //! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
@@ -23,6 +24,7 @@ pub mod material;
 pub mod mls;
 pub mod monotone_bicubic;
 pub mod monotone_cubic;
+pub mod ranges;
 pub mod residual;
 pub mod shape;
 pub mod synthetic;
@@ -30,4 +32,5 @@ pub mod synthetic;
 pub use difference::diff_spline_materials;
 pub use fit::{FitError, TermError, fit_errors, fit_grid};
 pub use material::{EnergyJet, SplineMaterial};
+pub use ranges::{RangeError, SampledRanges, sampled_ranges};
 pub use shape::{TermShape, term_shapes};

@@ -4,6 +4,7 @@ use std::collections::HashSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use yarnhom_artifacts::{YarnModel, arcsim::read_spline, pyp::parse_pyp};
+use yarnhom_fit::sampled_ranges;
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
     AxisKind, LineResult, PlanRanges, SampleError, SampleOptions, SamplePlan, SampleRanges, SweepLine,
@@ -42,33 +43,26 @@ fn ranges_must_contain_zero_and_stay_valid_strains() {
     assert!(broken(4, f64::NAN, 1.0), "finite");
 }
 
-/// The published fits place their control points over a fixed share ("span") of the sampled
-/// range: 0.95 for 1D terms (Alg. 4), 0.9 for 2D terms (Alg. 5) and 0.3 for the stockinette's
-/// bending terms (Sec. 4.3). The default ranges are those that give `stock1.json`'s knots.
+/// The default ranges are those `stock1.json` was sampled over, as its control points give them
+/// back (`yarnhom_fit::ranges`).
 #[test]
 fn the_default_ranges_are_those_of_the_published_stockinette_fit() {
     let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
-    let published = read_spline(std::path::Path::new(&path)).expect("stock1.json");
-    let extent = |knots: &[f64], axis: u8, span: f64| {
-        let scale = published.strain_scale[axis as usize];
-        [knots[0] * scale / span, knots[knots.len() - 1] * scale / span]
-    };
-    let close = |a: [f64; 2], b: [f64; 2]| {
-        (a[0] - b[0]).abs() <= 1e-9 * b[0].abs() && (a[1] - b[1]).abs() <= 1e-9 * b[1]
-    };
+    let published =
+        sampled_ranges(&read_spline(std::path::Path::new(&path)).expect("stock1.json")).expect("ranges");
+    let close = |a: [f64; 2], b: [f64; 2]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-9 * y.abs());
     let ranges = PlanRanges::default();
-    for term in &published.terms_1d {
-        let a = term.axis as usize;
-        let ours = [ranges.single.lower[a], ranges.single.upper[a]];
-        assert!(close(extent(&term.knots, term.axis, 0.95), ours), "1D {a}: {ours:?}");
+    for (axis, &range) in published.single.iter().enumerate() {
+        let ours = [ranges.single.lower[axis], ranges.single.upper[axis]];
+        assert!(close(ours, range), "1D {axis}: {ours:?} vs {range:?}");
     }
-    assert_eq!(published.terms_2d.len(), 9);
-    for term in &published.terms_2d {
-        let axes = term.axes.map(usize::from);
-        let plane = ranges.planes.iter().find(|p| p.axes == axes).expect("plane");
-        let span = if axes[1] >= 3 { 0.3 } else { 0.9 };
-        assert!(close(extent(&term.u_knots, term.axes[0], span), plane.ranges[0]), "{axes:?}: {plane:?}");
-        assert!(close(extent(&term.v_knots, term.axes[1], span), plane.ranges[1]), "{axes:?}: {plane:?}");
+    assert_eq!(published.planes.len(), ranges.planes.len());
+    for (plane, (axes, range)) in ranges.planes.iter().zip(&published.planes) {
+        assert_eq!(plane.axes, axes.map(usize::from));
+        assert!(
+            close(plane.ranges[0], range[0]) && close(plane.ranges[1], range[1]),
+            "{plane:?} vs {range:?}"
+        );
     }
 }
 
