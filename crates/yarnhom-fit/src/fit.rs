@@ -20,7 +20,7 @@ use crate::monotone_bicubic::make_monotone_bicubic;
 use crate::residual::{residualize_1d, residualize_2d, zero_compressed};
 
 /// The shear axis, symmetrized when [`FitSettings::symmetrize_shear`] (Sec. 4.3).
-const SHEAR: usize = 1;
+pub(crate) const SHEAR: usize = 1;
 /// The pair `(sx, sy)` whose residual keeps its shape: no marching, no zeroed compression
 /// (A.3.4, A.3.6), so it carries the Poisson effect.
 const POISSON_PAIR: [usize; 2] = [0, 2];

@@ -11,12 +11,12 @@
 use yarnhom_artifacts::grid::AXIS_NAMES;
 use yarnhom_artifacts::{FitSettings, Spline, SplineOrigin};
 
+use crate::fit::SHEAR;
+
 /// The span of the stockinette's 2D bending control points (Sec. 4.3: concentrated near the
 /// origin for curling knits); `yarnhom fit --stockinette` uses it.
 pub const STOCKINETTE_SPAN_2D_BENDING: f64 = 0.3;
 
-/// Index of `sa` in `(sx, sa, sy, kx, ky)`.
-const SHEAR: u8 = 1;
 /// Relative tolerance for two recovered ranges to be the same.
 const SAME_RANGE: f64 = 1e-6;
 
@@ -100,7 +100,8 @@ fn bending_span(
     extent: &impl Fn(&[f64], u8, f64) -> [f64; 2],
 ) -> Result<f64, RangeError> {
     let axis = axes[0];
-    let partner = if axis == SHEAR { 0 } else { SHEAR };
+    let shear = SHEAR as u8;
+    let partner = if axis == shear { 0 } else { shear };
     let pair = if axis < partner { [axis, partner] } else { [partner, axis] };
     let reference =
         in_plane.iter().find(|(a, _)| *a == pair).map(|(a, r)| r[usize::from(a[1] == axis)]).ok_or_else(
