@@ -9,7 +9,7 @@
 //! - [`shape`]: single-minimum checks of the fitted terms (A.36).
 //! - [`ranges`]: the strain ranges a fitted material was sampled over, from its control points.
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
-//! - [`curvature`]: principal curvatures of `II` robust at umbilics (A.39)-(A.41).
+//! - [`curvature`]: the curvature split (A.39)-(A.41), smooth at umbilics.
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
 //! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
 //! - [`difference`]: two spline materials compared by their energies and stresses on a dense
