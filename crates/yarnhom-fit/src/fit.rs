@@ -11,6 +11,7 @@ use yarnhom_artifacts::{
     AxisLimit, BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
 };
 
+use crate::hermite::Cubic;
 use crate::march::{
     bending_minimum_index, bending_minimum_row, clamp_boundary_for_extrapolation_2d, march_2d,
     quasiconvexify_1d, zero_knot_index,
@@ -69,14 +70,23 @@ pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -
         &restricted
     };
     let scale = strain_scale(grid);
+    // The 1D terms first: the 2D terms take their axis lines from them.
     let mut terms_1d = Vec::new();
+    for (t, term) in grid.terms.iter().enumerate() {
+        if let [axis] = *term.axes.as_slice() {
+            terms_1d.push(fit_1d(
+                axis as usize,
+                &TermData::gather(grid, t, &scale, settings.mls_radius)?,
+                settings,
+            )?);
+        }
+    }
     let mut terms_2d = Vec::new();
     for (t, term) in grid.terms.iter().enumerate() {
-        let data = TermData::gather(grid, t, &scale, settings.mls_radius)?;
-        match *term.axes.as_slice() {
-            [axis] => terms_1d.push(fit_1d(axis as usize, &data, settings)?),
-            [u, v] => terms_2d.push(fit_2d([u as usize, v as usize], &data, settings)?),
-            _ => {}
+        if let [u, v] = *term.axes.as_slice() {
+            let data = TermData::gather(grid, t, &scale, settings.mls_radius)?;
+            let along = |axis: u8| terms_1d.iter().find(|f: &&CubicTerm| f.axis == axis);
+            terms_2d.push(fit_2d([u as usize, v as usize], &data, [along(u), along(v)], settings)?);
         }
     }
     Ok(Spline {
@@ -199,8 +209,14 @@ fn fit_1d(axis: usize, data: &TermData, settings: &FitSettings) -> Result<CubicT
     Ok(CubicTerm { axis: axis as u8, knots, values, slopes })
 }
 
-/// Alg. 5: one 2D residual term over axes `[u, v]`.
-fn fit_2d(axes: [usize; 2], data: &TermData, settings: &FitSettings) -> Result<BicubicTerm, FitError> {
+/// Alg. 5: one 2D residual term over axes `[u, v]`; `axis_terms` are the fitted 1D terms of `u`
+/// and `v`, if the grid has them (see [`move_onto_1d_terms`]).
+fn fit_2d(
+    axes: [usize; 2],
+    data: &TermData,
+    axis_terms: [Option<&CubicTerm>; 2],
+    settings: &FitSettings,
+) -> Result<BicubicTerm, FitError> {
     let no_support = || FitError::NoSupport { term: data.name.clone() };
     let no_zero = || FitError::NoZeroKnot { term: data.name.clone() };
     let span = if axes[1] >= 3 { settings.span_2d_bending } else { settings.span_2d };
@@ -209,6 +225,8 @@ fn fit_2d(axes: [usize; 2], data: &TermData, settings: &FitSettings) -> Result<B
         (control_points(data.ranges[0], span, per_side), control_points(data.ranges[1], span, per_side));
     let mut h = smoothed_hermite_2d(axes, data, settings, &u_knots, &v_knots).ok_or_else(no_support)?;
     let i_min = zero_knot_index(&u_knots).ok_or_else(no_zero)?;
+    let j0 = zero_knot_index(&v_knots).ok_or_else(no_zero)?;
+    move_onto_1d_terms(&mut h, [&u_knots, &v_knots], [i_min, j0], axis_terms);
     if axes == POISSON_PAIR {
         // A.3.5: f13 is not marched; its boundary tangents are only made non-decreasing outward.
         clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, 0.0);
@@ -239,6 +257,49 @@ fn fit_2d(axes: [usize; 2], data: &TermData, settings: &FitSettings) -> Result<B
         dv: h.dv,
         duv: h.duv,
     })
+}
+
+/// The regularized plane `f*` moved onto the fitted 1D terms: `f* + g(u) + h(v)` with `g`, `h`
+/// the differences between the 1D terms and `f*`'s own axis lines, so that its axis lines
+/// become `f*(0, 0) + f_u(u)` and `f*(0, 0) + f_v(v)` at the nodes (values and slopes).
+///
+/// The residual (A.38) does not change (it removes functions of one variable), but the energy
+/// on the plane, `f0 + f_u + f_v + r`, is now this `f*` up to re-interpolating `f_u`, `f_v` on
+/// the plane's control points, so the marching (A.36) acts on the energy the material shows.
+/// Marching the plane's own `f*` left that sum with the difference between two fits of the
+/// same axis data on different control points, which made second minima where `f*` is flat.
+fn move_onto_1d_terms(
+    h: &mut HermiteGrid,
+    [u_knots, v_knots]: [&[f64]; 2],
+    [i0, j0]: [usize; 2],
+    [f_u, f_v]: [Option<&CubicTerm>; 2],
+) {
+    let nu = u_knots.len();
+    let origin = h.values[j0 * nu + i0];
+    let cubic =
+        |f: &CubicTerm| Cubic { knots: f.knots.clone(), values: f.values.clone(), slopes: f.slopes.clone() };
+    // (g, g') at the u knots and (h, h') at the v knots; zero without a 1D term.
+    let shift = |f: Option<Cubic>, knots: &[f64], line: &dyn Fn(usize) -> (f64, f64)| -> Vec<(f64, f64)> {
+        (0..knots.len())
+            .map(|k| match &f {
+                Some(f) => {
+                    let (jet, (value, slope)) = (f.jet(knots[k]), line(k));
+                    (origin + jet.value - value, jet.d1 - slope)
+                }
+                None => (0.0, 0.0),
+            })
+            .collect()
+    };
+    let g = shift(f_u.map(cubic), u_knots, &|i| (h.values[j0 * nu + i], h.du[j0 * nu + i]));
+    let hv = shift(f_v.map(cubic), v_knots, &|j| (h.values[j * nu + i0], h.dv[j * nu + i0]));
+    for (j, &(hj, dhj)) in hv.iter().enumerate() {
+        for (i, &(gi, dgi)) in g.iter().enumerate() {
+            let n = j * nu + i;
+            h.values[n] += gi + hj;
+            h.du[n] += dgi;
+            h.dv[n] += dhj;
+        }
+    }
 }
 
 /// Alg. 5 lines 2-9: MLS-smoothed Hermite data at the nodes, symmetrized in `sa` where it is

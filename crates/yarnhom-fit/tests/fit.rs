@@ -244,6 +244,32 @@ fn marched_2d_terms_have_at_most_one_minimum_per_grid_line() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// The published `stock.pyp` sampled with its Table 4.1 yarn on a reduced plan:
+/// `yarnhom rve sample ../shared/data/hylc-patterns/stock.pyp --model table4.1:stock --n1d 40
+/// --n2d 12` (all 1496 samples converged).
+fn published_stockinette_grid() -> Grid {
+    let path = format!("{}/tests/data/stock-40x12.grid.yh", env!("CARGO_MANIFEST_DIR"));
+    yarnhom_artifacts::container::read::<Grid>(&path).expect("the stockinette grid fixture").1
+}
+
+#[test]
+fn the_published_stockinettes_grid_is_reproduced_with_few_second_minima() {
+    // Issue 4's bar on real data: as modelled, 1D terms within 5% and 2D terms within 10%.
+    let grid = published_stockinette_grid();
+    let (spline, material) = fit(&grid);
+    for e in fit_errors(&grid, &material, spline.rest_energy_density_j_m2, true) {
+        let modelled = e.relative_rms_modelled.expect("samples remain");
+        let bar = if e.term.contains(',') { 0.10 } else { 0.05 };
+        assert!(modelled < bar, "{}: {modelled}", e.term);
+    }
+    // The energy on each plane adds the 1D terms to the plane's residual; marched on the
+    // plane's own fit, the sum had second minima on 17 of the 162 lines through the control
+    // points (sa,kx on 8 of 18); marched with the 1D terms on its axes, 6, and none on sa,kx.
+    let failures = quasiconvexity_failures(&grid, &spline);
+    assert!(failures.len() <= 6, "{failures:#?}");
+    assert!(!failures.iter().any(|f| f.starts_with("sa,kx")), "{failures:#?}");
+}
+
 #[test]
 fn the_fit_is_symmetric_in_shear() {
     let (spline, _) = fit(&synthetic_grid());
