@@ -248,7 +248,7 @@ fn print_errors(grid: &Grid, spline: &Spline, symmetrized_shear: bool) {
 fn print_shapes(grid: &Grid, spline: &Spline) {
     println!(
         "single minimum of the fitted energy on each term's axis or plane, along every line through its \
-         control points, over 1.5x the sampled range (A.36):"
+         control points, halfway between them and along the edges, over 1.5x the sampled range (A.36):"
     );
     for shape in term_shapes(grid, spline, 1e-6) {
         match shape.violations.first() {

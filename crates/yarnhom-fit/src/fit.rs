@@ -241,7 +241,9 @@ fn fit_2d(
         let min_slope = settings.min_slope;
         clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, min_slope);
     }
+    let axis_lines = AxisLineSlopes::of(&h, [u_knots.len(), v_knots.len()], [i_min, j0]);
     make_monotone_bicubic(&u_knots, &v_knots, &h.values, &mut h.du, &mut h.dv, &mut h.duv);
+    axis_lines.restore(&mut h, axis_terms.map(|f| f.is_some()));
     residualize_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv).map_err(|_| no_zero())?;
     if axes != POISSON_PAIR {
         let compressible = |axis: usize| axis == 0 || axis == 2;
@@ -298,6 +300,52 @@ fn move_onto_1d_terms(
             h.values[n] += gi + hj;
             h.du[n] += dgi;
             h.dv[n] += dhj;
+        }
+    }
+}
+
+/// The slopes along a plane's axis lines (`p^u` on the row `v = 0`, `p^v` on the column
+/// `u = 0`), kept across the monotone step (App. B).
+///
+/// After [`move_onto_1d_terms`] these are the 1D terms' slopes, and the residual (A.38)
+/// subtracts the axis lines from the whole plane, so that the material's energy on the plane is
+/// the plane's patch plus the difference between each 1D term and the plane's axis line. The
+/// monotone step projects the slopes of every node, the axis lines' included (to make the cells
+/// beside them monotone); left there, that difference, zero in value at the control points but
+/// not in slope, entered every line of the plane and made second minima where the plane is
+/// flat (the thesis-size stockinette: on 17 of the 304 lines [`crate::shape`] checks, 10 with
+/// the slopes restored). Restored, it is zero, and only the cells beside the axis lines may
+/// lose App. B's guarantee.
+struct AxisLineSlopes {
+    /// `p^u` on the row `v = 0`, per `u` control point.
+    row: Vec<f64>,
+    /// `p^v` on the column `u = 0`, per `v` control point.
+    column: Vec<f64>,
+    nu: usize,
+    origin: [usize; 2],
+}
+
+impl AxisLineSlopes {
+    fn of(h: &HermiteGrid, [nu, nv]: [usize; 2], [i0, j0]: [usize; 2]) -> Self {
+        let row = h.du[j0 * nu..(j0 + 1) * nu].to_vec();
+        let column = (0..nv).map(|j| h.dv[j * nu + i0]).collect();
+        Self { row, column, nu, origin: [i0, j0] }
+    }
+
+    /// Put back the slopes of the axis lines that are 1D terms (`[u, v]`), but at their ends:
+    /// the boundary slopes set the extrapolation (A.3.5), which the monotone step makes
+    /// increasing across the boundary too.
+    fn restore(&self, h: &mut HermiteGrid, [along_u, along_v]: [bool; 2]) {
+        let (nu, nv, [i0, j0]) = (self.nu, self.column.len(), self.origin);
+        if along_u {
+            for i in 1..nu - 1 {
+                h.du[j0 * nu + i] = self.row[i];
+            }
+        }
+        if along_v {
+            for j in 1..nv - 1 {
+                h.dv[j * nu + i0] = self.column[j];
+            }
         }
     }
 }

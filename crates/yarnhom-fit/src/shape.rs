@@ -1,7 +1,8 @@
 //! Checks of a fitted material's shape: each quasiconvexified term has a single minimum
 //! (A.36). For a 1D term the fitted energy along its axis, for a marched 2D term the fitted
 //! energy on its plane (`f0 + f_u + f_v + f_uv`, the regularized `f*` of A.3.6 the marching acts
-//! on) along every line through its control points, over 1.5 times the sampled range.
+//! on) along every line through its control points, halfway between them and along the edges of
+//! the checked region, over 1.5 times the sampled range.
 
 use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values};
 use yarnhom_artifacts::{Grid, Spline, StrainSample};
@@ -90,16 +91,25 @@ pub fn term_shapes(grid: &Grid, spline: &Spline, relative_tolerance: f64) -> Vec
 }
 
 /// The lines of a term: its axis for a 1D term; for a 2D term, along `u` at every `v` control
-/// point and along `v` at every `u` control point (points as strain values of the axes).
+/// point, halfway between neighbouring ones and at both ends of the checked `v` range (where
+/// the patch extrapolates, A.3.5), and likewise along `v` (points as strain values of the axes).
 fn lines_through_knots(spline: &Spline, axes: &[u8], ranges: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
     let Some(term) = spline.terms_2d.iter().find(|t| t.axes.as_slice() == axes) else {
         return vec![ranges[0].iter().map(|&x| vec![x]).collect()];
     };
-    let scale = |axis: u8| spline.strain_scale[axis as usize];
-    let along_u =
-        term.v_knots.iter().map(|&k| ranges[0].iter().map(|&u| vec![u, k * scale(axes[1])]).collect());
-    let along_v =
-        term.u_knots.iter().map(|&k| ranges[1].iter().map(|&v| vec![k * scale(axes[0]), v]).collect());
+    let at = |knots: &[f64], axis: u8, range: &[f64]| -> Vec<f64> {
+        let scale = spline.strain_scale[axis as usize];
+        let mut at: Vec<f64> = knots.iter().map(|&k| k * scale).collect();
+        at.extend(knots.windows(2).map(|w| 0.5 * (w[0] + w[1]) * scale));
+        at.extend([range[0], range[range.len() - 1]]);
+        at
+    };
+    let along_u = at(&term.v_knots, axes[1], &ranges[1])
+        .into_iter()
+        .map(|v| ranges[0].iter().map(|&u| vec![u, v]).collect::<Vec<_>>());
+    let along_v = at(&term.u_knots, axes[0], &ranges[0])
+        .into_iter()
+        .map(|u| ranges[1].iter().map(|&v| vec![u, v]).collect::<Vec<_>>());
     along_u.chain(along_v).collect()
 }
 

@@ -94,9 +94,10 @@ fn value_range(ys: &[f64]) -> f64 {
 
 /// The marched 2D terms (all but `f_{sx,sy}`, A.3.4) must be quasiconvex: the fitted energy on
 /// the term's plane, `f0 + f_u + f_v + f_uv` (the regularized `f*` of A.3.6 that the marching
-/// acts on), has at most one local minimum along every line through the term's knots, over 1.5
-/// times the sampled range (plateaus allowed, up to 1e-6 of the energy range); returns the
-/// violations ([`yarnhom_fit::shape`], also printed by `yarnhom fit`).
+/// acts on), has at most one local minimum along every line through the term's knots, halfway
+/// between them and along the edges, over 1.5 times the sampled range (plateaus allowed, up to
+/// 1e-6 of the energy range); returns the violations ([`yarnhom_fit::shape`], also printed by
+/// `yarnhom fit`).
 fn quasiconvexity_failures(grid: &Grid, spline: &Spline) -> Vec<String> {
     term_shapes(grid, spline, 1e-6)
         .into_iter()
@@ -265,9 +266,12 @@ fn the_published_stockinettes_grid_is_reproduced_with_few_second_minima() {
     // The energy on each plane adds the 1D terms to the plane's residual; marched on the
     // plane's own fit, the sum had second minima on 17 of the 162 lines through the control
     // points (sa,kx on 8 of 18); marched with the 1D terms on its axes, 6, and none on sa,kx.
+    // Checked also halfway between the control points and along the edges (304 lines): 12, in
+    // the outermost interval of sa in sa,sy and sa,ky, where the monotone step lowers the 1D
+    // term's end slope to keep the extrapolation increasing (A.3.5).
     let failures = quasiconvexity_failures(&grid, &spline);
-    assert!(failures.len() <= 6, "{failures:#?}");
-    assert!(!failures.iter().any(|f| f.starts_with("sa,kx")), "{failures:#?}");
+    assert!(failures.len() <= 12, "{failures:#?}");
+    assert!(failures.iter().all(|f| f.starts_with("sa,sy") || f.starts_with("sa,ky")), "{failures:#?}");
 }
 
 #[test]
