@@ -305,7 +305,7 @@ fn move_onto_1d_terms(
 }
 
 /// The slopes along a plane's axis lines (`p^u` on the row `v = 0`, `p^v` on the column
-/// `u = 0`), kept across the monotone step (App. B).
+/// `u = 0`), kept across the monotone step (App. B) at the interior control points.
 ///
 /// After [`move_onto_1d_terms`] these are the 1D terms' slopes, and the residual (A.38)
 /// subtracts the axis lines from the whole plane, so that the material's energy on the plane is
@@ -314,8 +314,9 @@ fn move_onto_1d_terms(
 /// beside them monotone); left there, that difference, zero in value at the control points but
 /// not in slope, entered every line of the plane and made second minima where the plane is
 /// flat (the thesis-size stockinette: on 17 of the 304 lines [`crate::shape`] checks, 10 with
-/// the slopes restored). Restored, it is zero, and only the cells beside the axis lines may
-/// lose App. B's guarantee.
+/// the slopes restored). Restored, it is zero but in the outermost intervals (see
+/// [`AxisLineSlopes::restore`]), and the cells beside the axis lines may lose App. B's
+/// guarantee.
 struct AxisLineSlopes {
     /// `p^u` on the row `v = 0`, per `u` control point.
     row: Vec<f64>,

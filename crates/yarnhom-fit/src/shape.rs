@@ -75,7 +75,7 @@ pub fn term_shapes(grid: &Grid, spline: &Spline, relative_tolerance: f64) -> Vec
             let ranges: Vec<Vec<f64>> =
                 term.values.iter().map(|v| linspace(1.5 * v[0], 1.5 * v[v.len() - 1], POINTS)).collect();
             let energy = |values: &[f64]| material.energy_at(&strain_along(&term.axes, values));
-            let lines = lines_through_knots(spline, &term.axes, &ranges);
+            let lines = checked_lines(spline, &term.axes, &ranges);
             let all: Vec<f64> = lines.iter().flat_map(|l| l.iter().map(|p| energy(p))).collect();
             let tol = relative_tolerance * value_range(&all);
             let violations = lines
@@ -93,7 +93,7 @@ pub fn term_shapes(grid: &Grid, spline: &Spline, relative_tolerance: f64) -> Vec
 /// The lines of a term: its axis for a 1D term; for a 2D term, along `u` at every `v` control
 /// point, halfway between neighbouring ones and at both ends of the checked `v` range (where
 /// the patch extrapolates, A.3.5), and likewise along `v` (points as strain values of the axes).
-fn lines_through_knots(spline: &Spline, axes: &[u8], ranges: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
+fn checked_lines(spline: &Spline, axes: &[u8], ranges: &[Vec<f64>]) -> Vec<Vec<Vec<f64>>> {
     let Some(term) = spline.terms_2d.iter().find(|t| t.axes.as_slice() == axes) else {
         return vec![ranges[0].iter().map(|&x| vec![x]).collect()];
     };
