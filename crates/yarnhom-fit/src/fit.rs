@@ -278,8 +278,6 @@ fn move_onto_1d_terms(
 ) {
     let nu = u_knots.len();
     let origin = h.values[j0 * nu + i0];
-    let cubic =
-        |f: &CubicTerm| Cubic { knots: f.knots.clone(), values: f.values.clone(), slopes: f.slopes.clone() };
     // (g, g') at the u knots and (h, h') at the v knots; zero without a 1D term.
     let shift = |f: Option<Cubic>, knots: &[f64], line: &dyn Fn(usize) -> (f64, f64)| -> Vec<(f64, f64)> {
         (0..knots.len())
@@ -292,8 +290,8 @@ fn move_onto_1d_terms(
             })
             .collect()
     };
-    let g = shift(f_u.map(cubic), u_knots, &|i| (h.values[j0 * nu + i], h.du[j0 * nu + i]));
-    let hv = shift(f_v.map(cubic), v_knots, &|j| (h.values[j * nu + i0], h.dv[j * nu + i0]));
+    let g = shift(f_u.map(Cubic::from), u_knots, &|i| (h.values[j0 * nu + i], h.du[j0 * nu + i]));
+    let hv = shift(f_v.map(Cubic::from), v_knots, &|j| (h.values[j * nu + i0], h.dv[j * nu + i0]));
     for (j, &(hj, dhj)) in hv.iter().enumerate() {
         for (i, &(gi, dgi)) in g.iter().enumerate() {
             let n = j * nu + i;

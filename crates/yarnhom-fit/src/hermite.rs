@@ -98,6 +98,13 @@ impl Cubic {
     }
 }
 
+impl From<&yarnhom_artifacts::CubicTerm> for Cubic {
+    /// The spline of a stored 1D term (in normalized strain).
+    fn from(term: &yarnhom_artifacts::CubicTerm) -> Self {
+        Self { knots: term.knots.clone(), values: term.values.clone(), slopes: term.slopes.clone() }
+    }
+}
+
 /// A bicubic Hermite patch with linear extrapolation.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bicubic {

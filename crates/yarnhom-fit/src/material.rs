@@ -68,15 +68,7 @@ impl From<&Spline> for SplineMaterial {
             terms_1d: spline
                 .terms_1d
                 .iter()
-                .map(|t| Term1d {
-                    axis: t.axis as usize,
-                    scale: scale(t.axis),
-                    spline: Cubic {
-                        knots: t.knots.clone(),
-                        values: t.values.clone(),
-                        slopes: t.slopes.clone(),
-                    },
-                })
+                .map(|t| Term1d { axis: t.axis as usize, scale: scale(t.axis), spline: Cubic::from(t) })
                 .collect(),
             terms_2d: spline
                 .terms_2d
