@@ -117,3 +117,17 @@ fn read_hdf5(path: &Path) -> anyhow::Result<(Header, AnyArtifact)> {
 fn read_hdf5(path: &Path) -> anyhow::Result<(Header, AnyArtifact)> {
     anyhow::bail!("{}: this yarnhom was built without the `hdf5` feature", path.display())
 }
+
+/// Load a pattern (`.yh`, JSON, HDF5 or `.pyp`) and the reference to it for provenance.
+pub fn load_pattern(path: &Path) -> anyhow::Result<(Pattern, InputRef)> {
+    let loaded = load(path, None)?;
+    let input = InputRef {
+        kind: "pattern".into(),
+        content_hash: loaded.header.content_hash.clone(),
+        path: path.display().to_string(),
+    };
+    let AnyArtifact::Pattern(pattern) = loaded.artifact else {
+        anyhow::bail!("{}: holds a '{}', not a pattern", path.display(), loaded.artifact.kind())
+    };
+    Ok((pattern, input))
+}

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::{AnyArtifact, Fabric, Pattern, container};
-use yarnhom_pattern::{GENERATORS, GeneratorParams};
+use yarnhom_pattern::{GENERATORS, GeneratorParams, MirrorAxis, find_mirror, mirrored};
 
 use crate::Outcome;
 use crate::inputs::{self, base_name, provenance};
@@ -25,6 +25,34 @@ pub enum PatternCommand {
     Import(ImportArgs),
     /// Export a pattern to `.pyp` (numbers written so that they read back exactly).
     Export(ExportArgs),
+    /// How far a pattern is from its mirror image (`X1 -> -X1` or `X2 -> -X2`, with the best
+    /// translation and yarn matching), and that image, rest state included.
+    ///
+    /// A tile that is its own mirror image answers the shears `sa` and `-sa` alike; one that is
+    /// not (the published stockinette: 0.58 radii RMS) answers them differently. The image
+    /// answers the mirrored strain exactly as the tile answers the strain.
+    Mirror(MirrorArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct MirrorArgs {
+    /// A pattern (`.yh`, JSON, HDF5 or `.pyp`).
+    pub input: PathBuf,
+    /// The coordinate the mirror negates.
+    #[arg(long, value_enum, default_value = "x1")]
+    pub axis: AxisArg,
+    /// Write the mirror image here.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+}
+
+/// Mirror axes on the command line.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+pub enum AxisArg {
+    /// `X1 -> -X1` (a knit's wale axis).
+    X1,
+    /// `X2 -> -X2`.
+    X2,
 }
 
 #[derive(Debug, Args)]
@@ -96,6 +124,7 @@ pub fn run(cmd: PatternCommand) -> anyhow::Result<Outcome> {
         PatternCommand::Generate(args) => generate(args),
         PatternCommand::Import(args) => import(args),
         PatternCommand::Export(args) => export(args),
+        PatternCommand::Mirror(args) => mirror(args),
     }
     .map(|()| Outcome::Success)
 }
@@ -152,6 +181,43 @@ fn export(args: ExportArgs) -> anyhow::Result<()> {
     let text = yarnhom_artifacts::pyp::write_pyp(pattern)?;
     let output = args.output.unwrap_or_else(|| format!("{}.pyp", base_name(&args.input)).into());
     write_text(&output, &text)
+}
+
+fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
+    let (pattern, input) = inputs::load_pattern(&args.input)?;
+    let pattern = &pattern;
+    let axis = match args.axis {
+        AxisArg::X1 => MirrorAxis::X1,
+        AxisArg::X2 => MirrorAxis::X2,
+    };
+    let mirror = find_mirror(pattern, axis)?;
+    let (r_lo, _) = pattern.radius_range_m();
+    println!(
+        "mirror {axis} of {} ({} yarn(s), {} vertices)",
+        pattern.name,
+        pattern.yarns.len(),
+        pattern.vertex_count()
+    );
+    for (y, reversed) in mirror.reversed.iter().enumerate() {
+        let onto = mirror.source[pattern.yarns[y].vertices[0] as usize];
+        let partner = pattern.yarns.iter().position(|yarn| yarn.vertices.contains(&onto)).unwrap_or(y);
+        let way = if *reversed { "backwards" } else { "forwards" };
+        println!("  yarn {y} <- yarn {partner}, {way}");
+    }
+    let t = mirror.shift_m;
+    println!("  translation ({:.4}, {:.4}, {:.4}) mm", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3);
+    println!(
+        "  vertices from their images: {:.4} mm RMS ({:.3} radii), {:.4} mm at most ({:.3} radii)",
+        mirror.rms_distance_m() * 1e3,
+        mirror.rms_distance_m() / r_lo,
+        mirror.max_distance_m() * 1e3,
+        mirror.max_distance_m() / r_lo
+    );
+    if let Some(output) = args.output {
+        let image = mirrored(pattern, &mirror)?;
+        write_pattern(&output, &image, provenance("pattern mirror", vec![input]))?;
+    }
+    Ok(())
 }
 
 fn write_pattern(

@@ -137,15 +137,7 @@ pub(crate) fn load_pattern_and_model(
     path: &std::path::Path,
     model_spec: &str,
 ) -> anyhow::Result<(yarnhom_artifacts::Pattern, YarnModel, Vec<yarnhom_artifacts::InputRef>)> {
-    let loaded = inputs::load(path, None)?;
-    let input = yarnhom_artifacts::InputRef {
-        kind: "pattern".into(),
-        content_hash: loaded.header.content_hash.clone(),
-        path: path.display().to_string(),
-    };
-    let AnyArtifact::Pattern(pattern) = loaded.artifact else {
-        anyhow::bail!("{}: holds a '{}', not a pattern", path.display(), loaded.artifact.kind())
-    };
+    let (pattern, input) = inputs::load_pattern(path)?;
     let (model, model_input) = load_model(model_spec)?;
     Ok((pattern, model, std::iter::once(input).chain(model_input).collect()))
 }

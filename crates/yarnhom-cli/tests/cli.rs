@@ -62,6 +62,22 @@ fn import_and_inspect_show_the_published_rib() {
 }
 
 #[test]
+fn pattern_mirror_reports_the_published_stockinettes_asymmetry_and_writes_its_image() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let stock = format!("{DATA}/stock.pyp");
+    let text = ok(&["pattern", "mirror", &stock, "-o", "image.pattern.yh"], d);
+    for expected in ["mirror X1 -> -X1 of stock", "yarn 0 <- yarn 0, backwards", "0.575 radii"] {
+        assert!(text.contains(expected), "missing '{expected}' in:\n{text}");
+    }
+    // The image is as far from its own image, and remembers where it came from.
+    let again = ok(&["pattern", "mirror", "image.pattern.yh"], d);
+    assert!(again.contains("0.575 radii"), "{again}");
+    assert!(ok(&["inspect", "image.pattern.yh"], d).contains("mirrored X1 -> -X1"));
+    fails_with(&["pattern", "mirror", "missing.pyp"], d, "missing.pyp");
+}
+
+#[test]
 fn damaged_files_give_one_line_errors_and_exit_2() {
     let dir = tempfile::tempdir().expect("tempdir");
     let path = rib(dir.path());

@@ -4,7 +4,7 @@
 use nalgebra::{Matrix3x2, Rotation3, Vector3};
 use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel, pyp::parse_pyp};
 use yarnhom_geom::{InPlaneStrain, MacroStrain};
-use yarnhom_pattern::{GeneratorParams, generate};
+use yarnhom_pattern::{GeneratorParams, MirrorAxis, find_mirror, generate, mirrored};
 use yarnhom_rve::assembly::RveState;
 use yarnhom_rve::homogenize::{solve_at, stress_at_equilibrium, stress_by_finite_differences};
 use yarnhom_rve::relax::RelaxEvent;
@@ -160,4 +160,39 @@ fn the_biphasic_yarn_stiffens_past_its_onset_strain() {
     };
     let (early, late) = (energy(0.0), energy(10.0));
     assert!(early > 2.0 * late, "early onset {early} vs late onset {late} J/m²");
+}
+
+#[test]
+fn the_mirror_image_of_a_tile_answers_the_mirrored_strain() {
+    // X1 -> -X1 maps the shear sa to -sa and keeps sx, sy, kx, ky: the mirror image of a
+    // published tile (rest state, frames and twists mirrored) stores the energy the tile stores
+    // under the mirrored strain. The stockinette's yarns run backwards in the mirror, the
+    // basket's warps forwards. In-plane, the solves are mirror images to round-off. Bent, not
+    // quite: the frame of an edge that crosses into a neighbouring tile image is co-rotated with
+    // `R` at the edge's first vertex (A.21), and where the mirror reverses a yarn the image takes
+    // `R` at the other end (2.3e-6 relative at kx = 20 1/m on the basket, converged).
+    let tight = SolveOptions { tolerance: 1e-9, ..SolveOptions::default() };
+    let psi = |model: &RveModel, strain: &str| {
+        let (report, _) = solve_at(model, &strain.parse().expect("strain"), None, &tight);
+        assert!(report.converged, "{strain}: {report:?}");
+        report.energy_density_j_m2
+    };
+    let in_plane = [("sx=0", "sx=0"), ("sa=0.1", "sa=-0.1"), ("sy=0.05,sa=-0.2", "sy=0.05,sa=0.2")];
+    let bent = [("kx=20", "kx=20"), ("ky=-10", "ky=-10")];
+    for name in ["stock", "basket"] {
+        let input = published(name);
+        let yarn = YarnModel::table_4_1(name).expect("Table 4.1 row");
+        let mirror = find_mirror(&input, MirrorAxis::X1).expect("a mirror");
+        let image = mirrored(&input, &mirror).expect("the image");
+        let tile = RveModel::new(&input, &yarn).expect("tile");
+        let image_tile = RveModel::new(&image, &yarn).expect("image tile");
+        let cases = in_plane.iter().map(|c| (c, 1e-12)).chain(bent.iter().map(|c| (c, 1e-5)));
+        for (&(strain, mirrored_strain), tolerance) in cases {
+            let (a, b) = (psi(&image_tile, strain), psi(&tile, mirrored_strain));
+            assert!(
+                (a - b).abs() < tolerance * b,
+                "{name} {strain}: image {a} vs tile at {mirrored_strain} {b}"
+            );
+        }
+    }
 }
