@@ -11,7 +11,7 @@
 //! The mirror `M x = R x + t` (`R` negates one in-plane coordinate) maps every yarn onto a yarn
 //! with the same vertex count: a yarn whose direction of travel `R` reverses (a course yarn under
 //! `X1 -> -X1`) is traversed backwards, `k -> m - k`, the others forwards, `k -> m + k`. The
-//! rod data transform as follows (Bergou et al. 2010's frames, [`yarnhom_rod::frames`]): an
+//! rod data transform as follows (Bergou et al. 2010's frames, as in `yarnhom_rod::frames`): an
 //! edge's reference director `d -> R d`; with the yarn traversed backwards its tangent goes to
 //! `-R t` and the material frame `(m1, m2) -> (R m1, R m2)`, so twist angles and curvatures
 //! `(κ1, κ2)` are kept; forwards, the tangent goes to `R t`, `(m1, m2) -> (R m1, -R m2)`, so twist
@@ -303,6 +303,7 @@ pub fn mirrored(pattern: &Pattern, mirror: &Mirror) -> Result<Pattern, MirrorErr
         let backwards = mirror.reversed[e.yarn];
         edge_source[e.from as usize] = mirror.source[if backwards { e.to } else { e.from } as usize];
     }
+    // Twist angles and κ2 keep their sign on yarns the mirror reverses, and change it on others.
     let sign = |v: u32| if reversed_at[v as usize] { 1.0 } else { -1.0 };
     let edge_twists: Vec<f64> = (0..pattern.vertex_count() as u32)
         .map(|v| sign(v) * pattern.edge_twist_rad[edge_source[v as usize] as usize])
