@@ -185,12 +185,11 @@ fn export(args: ExportArgs) -> anyhow::Result<()> {
 
 fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
     let (pattern, input) = inputs::load_pattern(&args.input)?;
-    let pattern = &pattern;
     let axis = match args.axis {
         AxisArg::X1 => MirrorAxis::X1,
         AxisArg::X2 => MirrorAxis::X2,
     };
-    let mirror = find_mirror(pattern, axis)?;
+    let mirror = find_mirror(&pattern, axis)?;
     let (r_lo, _) = pattern.radius_range_m();
     println!(
         "mirror {axis} of {} ({} yarn(s), {} vertices)",
@@ -198,9 +197,7 @@ fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
         pattern.yarns.len(),
         pattern.vertex_count()
     );
-    for (y, reversed) in mirror.reversed.iter().enumerate() {
-        let onto = mirror.source[pattern.yarns[y].vertices[0] as usize];
-        let partner = pattern.yarns.iter().position(|yarn| yarn.vertices.contains(&onto)).unwrap_or(y);
+    for (y, (partner, reversed)) in mirror.partner.iter().zip(&mirror.reversed).enumerate() {
         let way = if *reversed { "backwards" } else { "forwards" };
         println!("  yarn {y} <- yarn {partner}, {way}");
     }
@@ -214,7 +211,7 @@ fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
         mirror.max_distance_m() / r_lo
     );
     if let Some(output) = args.output {
-        let image = mirrored(pattern, &mirror)?;
+        let image = mirrored(&pattern, &mirror)?;
         write_pattern(&output, &image, provenance("pattern mirror", vec![input]))?;
     }
     Ok(())

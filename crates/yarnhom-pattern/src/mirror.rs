@@ -73,6 +73,8 @@ pub struct Mirror {
     pub axis: MirrorAxis,
     /// `source[v]`: the vertex whose mirror image lands nearest vertex `v`.
     pub source: Vec<u32>,
+    /// Per yarn: the yarn whose mirror image it lies on.
+    pub partner: Vec<usize>,
     /// Per yarn: whether the mirror traverses it backwards.
     pub reversed: Vec<bool>,
     /// The translation `t` of the mirror `x -> R x + t` (m), within half a period of 0.
@@ -257,6 +259,7 @@ pub fn find_mirror(pattern: &Pattern, axis: MirrorAxis) -> Result<Mirror, Mirror
     Ok(Mirror {
         axis,
         source,
+        partner: matches.iter().map(|m| m.partner).collect(),
         reversed: matches.iter().map(|m| m.reversed).collect(),
         shift_m: shift.into(),
         residual_m: residual,
