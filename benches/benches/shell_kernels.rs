@@ -1,7 +1,9 @@
 //! The per-element kernels of the thin-shell simulator, one interior triangle of a curved,
 //! stretched and sheared cloth with the published honeycomb material (`honey1.json`):
 //! - the discrete forms (4.4)-(4.7) with their gradient and Hessian over the 18 stencil DOFs,
-//! - the whole element: forms, the spline material's derivatives and the A.5 composition,
+//!   and with their gradient only (what a gradient or a handle force needs),
+//! - the whole element: forms, the spline material's derivatives and the A.5 composition, with
+//!   and without the element Hessian,
 //! - the eigenvalue clamp of its 18 x 18 Hessian (Sec. 4.2),
 //! - the edge-hinge bending energy (6.4) with derivatives.
 //!
@@ -13,7 +15,7 @@ use nalgebra::{Vector2, Vector3};
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::split_hessian_18;
-use yarnhom_shell::forms::{RestTriangle, Stencil, forms_with_derivatives};
+use yarnhom_shell::forms::{RestTriangle, Stencil, forms_with_derivatives, forms_with_gradient};
 use yarnhom_shell::hinge::{HingeRest, hinge_energy_with_derivatives};
 use yarnhom_shell::{ElasticModel, ShellMaterial, ShellMesh};
 
@@ -46,8 +48,14 @@ fn bench_kernels(c: &mut Criterion) {
     g.bench_function("forms (4.4)-(4.7) with gradient and Hessian, 18 DOFs", |b| {
         b.iter(|| forms_with_derivatives(&rest, std::hint::black_box(&stencil)))
     });
+    g.bench_function("forms (4.4)-(4.7) with gradient only, 18 DOFs", |b| {
+        b.iter(|| forms_with_gradient(&rest, std::hint::black_box(&stencil)))
+    });
     g.bench_function("spline element: forms, material jet, A.5 composition", |b| {
         b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), true))
+    });
+    g.bench_function("spline element, energy and gradient only", |b| {
+        b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), false))
     });
     g.bench_function("eigenvalue clamp of an indefinite 18x18 element Hessian", |b| {
         b.iter(|| split_hessian_18(std::hint::black_box(hessian)).clamped())

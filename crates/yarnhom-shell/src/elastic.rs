@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use crate::forms::{
     RestTriangle, Stencil, first_form_of, first_form_with_derivatives, forms, forms_with_derivatives,
+    forms_with_gradient,
 };
 use crate::hinge::{HingeRest, anisotropic_stiffness, hinge_energy, hinge_energy_with_derivatives};
 use crate::material::ShellMaterial;
@@ -330,20 +331,23 @@ impl ElasticModel {
     /// entries are zero).
     pub fn triangle_element_exact(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> Element<18> {
         let rest = &self.rest[t];
-        let forms = forms_with_derivatives(rest, &self.stencil(t, x));
-        let jet = self.material.jet(forms.first, forms.second);
+        let stencil = self.stencil(t, x);
         let area = rest.rest_area;
+        if !hessian {
+            let forms = forms_with_gradient(rest, &stencil);
+            let jet = self.material.jet(forms.first, forms.second);
+            return (area * jet.value, area * forms.gradient.transpose() * jet.gradient, None);
+        }
+        let forms = forms_with_derivatives(rest, &stencil);
+        let jet = self.material.jet(forms.first, forms.second);
         let gradient = area * forms.gradient.transpose() * jet.gradient;
-        let h = hessian.then(|| {
-            let mut h = forms.gradient.transpose() * jet.hessian * forms.gradient;
-            for (k, d2z) in forms.hessian.iter().enumerate() {
-                if jet.gradient[k] != 0.0 {
-                    h += jet.gradient[k] * d2z;
-                }
+        let mut h = forms.gradient.transpose() * jet.hessian * forms.gradient;
+        for (k, d2z) in forms.hessian.iter().enumerate() {
+            if jet.gradient[k] != 0.0 {
+                h += jet.gradient[k] * d2z;
             }
-            area * h
-        });
-        (area * jet.value, gradient, h)
+        }
+        (area * jet.value, gradient, Some(area * h))
     }
 }
 

@@ -80,6 +80,18 @@ pub struct FormsWithDerivatives {
     pub hessian: [SMatrix<f64, 18, 18>; 6],
 }
 
+/// `I`, `II` and their exact gradients over the 18 stencil DOFs: what a gradient needs, without
+/// the 15 KB of Hessians.
+#[derive(Clone, Debug)]
+pub struct FormsWithGradient {
+    /// `[I11, I12, I22]`, eq. (4.6).
+    pub first: [f64; 3],
+    /// `[II11, II12, II22]`, eq. (4.7).
+    pub second: [f64; 3],
+    /// Rows: `I11, I12, I22, II11, II12, II22`.
+    pub gradient: SMatrix<f64, 6, 18>,
+}
+
 /// Current (world) area of a triangle.
 pub fn current_area(triangle: &[Vec3; 3]) -> f64 {
     0.5 * triangle_normal(triangle).norm()
@@ -139,21 +151,42 @@ impl FormsWithDerivatives {
     /// Overwrites `self` with the forms of `stencil` and their derivatives (no 15 KB move,
     /// unlike [`forms_with_derivatives`]).
     pub fn evaluate(&mut self, rest: &RestTriangle, stencil: &Stencil) {
-        let w = rest.barycentric_gradients();
-        let x = &stencil.triangle;
-        self.second = [0.0; 3];
-        self.area = current_area(x);
-        self.gradient.as_mut_slice().fill(0.0);
         for hessian in &mut self.hessian {
             hessian.as_mut_slice().fill(0.0);
         }
-        add_first_form(self, rest, x);
-        for (i, neighbour) in stencil.neighbours.iter().enumerate() {
-            if let Some(far) = neighbour {
-                add_edge_term(self, &w[i], x, i, far);
-            }
+        let forms = accumulate_forms(rest, stencil, Some(&mut self.hessian));
+        self.first = forms.first;
+        self.second = forms.second;
+        self.gradient = forms.gradient;
+        self.area = current_area(&stencil.triangle);
+    }
+}
+
+/// `(I, II)` with exact gradients over the 18 stencil DOFs.
+pub fn forms_with_gradient(rest: &RestTriangle, stencil: &Stencil) -> FormsWithGradient {
+    accumulate_forms(rest, stencil, None)
+}
+
+/// The forms of `stencil` with their gradients, adding their Hessians to `hessian` if given.
+fn accumulate_forms(
+    rest: &RestTriangle,
+    stencil: &Stencil,
+    mut hessian: Option<&mut [SMatrix<f64, 18, 18>; 6]>,
+) -> FormsWithGradient {
+    let w = rest.barycentric_gradients();
+    let x = &stencil.triangle;
+    let mut out = FormsWithGradient {
+        first: [0.0; 3],
+        second: [0.0; 3],
+        gradient: SMatrix::from_array_storage(ArrayStorage([[0.0; 6]; 18])),
+    };
+    add_first_form(&mut out, hessian.as_deref_mut(), rest, x);
+    for (i, neighbour) in stencil.neighbours.iter().enumerate() {
+        if let Some(far) = neighbour {
+            add_edge_term(&mut out, hessian.as_deref_mut(), &w[i], x, i, far);
         }
     }
+    out
 }
 
 /// `I` of a triangle, eq. (4.6); value only.
@@ -219,11 +252,16 @@ pub fn first_form_with_derivatives(rest: &RestTriangle, x: &[Vec3; 3]) -> FirstF
 
 /// The first form's rows of [`FormsWithDerivatives`]: the triangle's DOFs are the stencil's
 /// first 9.
-fn add_first_form(out: &mut FormsWithDerivatives, rest: &RestTriangle, x: &[Vec3; 3]) {
+fn add_first_form(
+    out: &mut FormsWithGradient,
+    hessian: Option<&mut [SMatrix<f64, 18, 18>; 6]>,
+    rest: &RestTriangle,
+    x: &[Vec3; 3],
+) {
     let first = first_form_with_derivatives(rest, x);
     out.first = first.first;
     out.gradient.fixed_view_mut::<3, 9>(0, 0).copy_from(&first.gradient);
-    for (hessian, block) in out.hessian.iter_mut().zip(&first.hessian) {
+    for (hessian, block) in hessian.into_iter().flatten().zip(&first.hessian) {
         hessian.fixed_view_mut::<9, 9>(0, 0).copy_from(block);
     }
 }
@@ -231,7 +269,14 @@ fn add_first_form(out: &mut FormsWithDerivatives, rest: &RestTriangle, x: &[Vec3
 /// Adds edge `i`'s term `c_i w_i ⊗ w_i` of (4.7), `c_i = θ_i h_i`, with its derivatives:
 /// `∇c = h ∇θ + θ ∇h`, `∇²c = h ∇²θ + θ ∇²h + ∇θ ⊗ ∇h + ∇h ⊗ ∇θ` over the hinge
 /// `[x_{i+1}, x_{i+2}, x_i, n_i]` (`h` = altitude of `x_i`, independent of `n_i`).
-fn add_edge_term(out: &mut FormsWithDerivatives, w_i: &Vector2<f64>, x: &[Vec3; 3], i: usize, far: &Vec3) {
+fn add_edge_term(
+    out: &mut FormsWithGradient,
+    mut hessian: Option<&mut [SMatrix<f64, 18, 18>; 6]>,
+    w_i: &Vector2<f64>,
+    x: &[Vec3; 3],
+    i: usize,
+    far: &Vec3,
+) {
     let [p0, p1, apex] = hinge_edge(x, i);
     let hinge = Hinge::new(&[p0, p1, apex, *far]);
     let (angle, altitude) = (hinge.angle(), hinge.wing_a.altitude);
@@ -242,6 +287,11 @@ fn add_edge_term(out: &mut FormsWithDerivatives, w_i: &Vector2<f64>, x: &[Vec3; 
     let slots = hinge_slots(i);
     for s in 0..4 {
         let gradient = angle_gradient[s] * altitude + altitude_gradient[s] * angle;
+        for (k, &factor) in factors.iter().enumerate() {
+            let mut row = out.gradient.fixed_view_mut::<1, 3>(3 + k, 3 * slots[s]);
+            row += (gradient * factor).transpose();
+        }
+        let Some(hessian) = hessian.as_deref_mut() else { continue };
         for t in s..4 {
             let cross = angle_gradient[s] * altitude_gradient[t].transpose()
                 + altitude_gradient[s] * angle_gradient[t].transpose();
@@ -250,12 +300,8 @@ fn add_edge_term(out: &mut FormsWithDerivatives, w_i: &Vector2<f64>, x: &[Vec3; 
                 block += hinge.wing_a.altitude_hessian_block(s, t) * angle;
             }
             for (k, &factor) in factors.iter().enumerate() {
-                add_symmetric_block(&mut out.hessian[3 + k], slots[s], slots[t], &(block * factor));
+                add_symmetric_block(&mut hessian[3 + k], slots[s], slots[t], &(block * factor));
             }
-        }
-        for (k, &factor) in factors.iter().enumerate() {
-            let mut row = out.gradient.fixed_view_mut::<1, 3>(3 + k, 3 * slots[s]);
-            row += (gradient * factor).transpose();
         }
     }
     for (entry, factor) in out.second.iter_mut().zip(factors) {
@@ -355,13 +401,16 @@ mod tests {
     }
 
     #[test]
-    fn derivative_path_values_match_value_path() {
+    fn derivative_and_gradient_paths_match_the_value_path() {
         let mut rng = XorShift::new(21);
         for mask in 0..8 {
             let rest = random_rest(&mut rng);
             let stencil = random_stencil(&mut rng, mask);
             let d = forms_with_derivatives(&rest, &stencil);
             let (first, second) = forms(&rest, &stencil);
+            // The gradient path does the derivative path's arithmetic without the Hessians.
+            let g = forms_with_gradient(&rest, &stencil);
+            assert_eq!((g.first, g.second, g.gradient), (d.first, d.second, d.gradient));
             for k in 0..3 {
                 assert_close(d.first[k], first[k], 1e-12);
                 assert_close(d.second[k], second[k], 1e-12);
