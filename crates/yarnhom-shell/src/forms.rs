@@ -250,8 +250,8 @@ pub fn first_form_with_derivatives(rest: &RestTriangle, x: &[Vec3; 3]) -> FirstF
     out
 }
 
-/// The first form's rows of [`FormsWithDerivatives`]: the triangle's DOFs are the stencil's
-/// first 9.
+/// The first form's rows of the gradient, and of the Hessians if given: the triangle's DOFs are
+/// the stencil's first 9.
 fn add_first_form(
     out: &mut FormsWithGradient,
     hessian: Option<&mut [SMatrix<f64, 18, 18>; 6]>,
