@@ -62,6 +62,26 @@ pub enum FitError {
 /// Fit a whole grid (Alg. 3), restricted to the settings' limits ([`restrict_grid`]).
 /// `areal_density_kg_m2` is the cloth's mass per area.
 pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -> Result<Spline, FitError> {
+    fit_grid_with_regularized_terms(grid, settings, areal_density_kg_m2).map(|fit| fit.spline)
+}
+
+/// A fitted material with the regularized 2D fits `f*_uv` (A.3.6) its residual terms came from:
+/// the quasiconvexified terms, which the marching (A.36) gives a single minimum each. (The 1D
+/// terms differ from their `f*_u` by a constant, A.37.)
+#[derive(Debug, Clone, PartialEq)]
+pub struct RegularizedFit {
+    /// The material.
+    pub spline: Spline,
+    /// `f*_uv` per 2D term, in the order of `spline.terms_2d`, on the same control points.
+    pub regularized_2d: Vec<BicubicTerm>,
+}
+
+/// [`fit_grid`] keeping the regularized 2D fits.
+pub fn fit_grid_with_regularized_terms(
+    grid: &Grid,
+    settings: &FitSettings,
+    areal_density_kg_m2: f64,
+) -> Result<RegularizedFit, FitError> {
     let restricted;
     let grid = if settings.limits.is_empty() {
         grid
@@ -81,15 +101,18 @@ pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -
             )?);
         }
     }
-    let mut terms_2d = Vec::new();
+    let (mut terms_2d, mut regularized_2d) = (Vec::new(), Vec::new());
     for (t, term) in grid.terms.iter().enumerate() {
         if let [u, v] = *term.axes.as_slice() {
             let data = TermData::gather(grid, t, &scale, settings.mls_radius)?;
             let along = |axis: u8| terms_1d.iter().find(|f: &&CubicTerm| f.axis == axis);
-            terms_2d.push(fit_2d([u as usize, v as usize], &data, [along(u), along(v)], settings)?);
+            let (residual, regularized) =
+                fit_2d([u as usize, v as usize], &data, [along(u), along(v)], settings)?;
+            terms_2d.push(residual);
+            regularized_2d.push(regularized);
         }
     }
-    Ok(Spline {
+    let spline = Spline {
         name: grid.pattern.clone(),
         areal_density_kg_m2,
         strain_scale: scale,
@@ -97,7 +120,8 @@ pub fn fit_grid(grid: &Grid, settings: &FitSettings, areal_density_kg_m2: f64) -
         terms_1d,
         terms_2d,
         origin: SplineOrigin::Fitted { settings: settings.clone() },
-    })
+    };
+    Ok(RegularizedFit { spline, regularized_2d })
 }
 
 /// The normalization of each strain axis: its largest magnitude in the plan (Alg. 3 line 2);
@@ -209,14 +233,15 @@ fn fit_1d(axis: usize, data: &TermData, settings: &FitSettings) -> Result<CubicT
     Ok(CubicTerm { axis: axis as u8, knots, values, slopes })
 }
 
-/// Alg. 5: one 2D residual term over axes `[u, v]`; `axis_terms` are the fitted 1D terms of `u`
-/// and `v`, if the grid has them (see [`move_onto_1d_terms`]).
+/// Alg. 5: one 2D residual term over axes `[u, v]` and the regularized fit `f*_uv` it is the
+/// residual of (A.38); `axis_terms` are the fitted 1D terms of `u` and `v`, if the grid has them
+/// (see [`move_onto_1d_terms`]).
 fn fit_2d(
     axes: [usize; 2],
     data: &TermData,
     axis_terms: [Option<&CubicTerm>; 2],
     settings: &FitSettings,
-) -> Result<BicubicTerm, FitError> {
+) -> Result<(BicubicTerm, BicubicTerm), FitError> {
     let no_support = || FitError::NoSupport { term: data.name.clone() };
     let no_zero = || FitError::NoZeroKnot { term: data.name.clone() };
     let span = if axes[1] >= 3 { settings.span_2d_bending } else { settings.span_2d };
@@ -241,24 +266,25 @@ fn fit_2d(
         let min_slope = settings.min_slope;
         clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, min_slope);
     }
-    let axis_lines = AxisLineSlopes::of(&h, [u_knots.len(), v_knots.len()], [i_min, j0]);
     make_monotone_bicubic(&u_knots, &v_knots, &h.values, &mut h.du, &mut h.dv, &mut h.duv);
-    axis_lines.restore(&mut h, axis_terms.map(|f| f.is_some()));
-    residualize_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv).map_err(|_| no_zero())?;
-    if axes != POISSON_PAIR {
-        let compressible = |axis: usize| axis == 0 || axis == 2;
-        let (cu, cv) = (compressible(axes[0]), compressible(axes[1]));
-        zero_compressed(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv, &mut h.duv, cu, cv);
-    }
-    Ok(BicubicTerm {
-        axes: [axes[0] as u8, axes[1] as u8],
-        u_knots,
-        v_knots,
+    let axes = [axes[0] as u8, axes[1] as u8];
+    let term = |h: HermiteGrid| BicubicTerm {
+        axes,
+        u_knots: u_knots.clone(),
+        v_knots: v_knots.clone(),
         values: h.values,
         du: h.du,
         dv: h.dv,
         duv: h.duv,
-    })
+    };
+    let regularized = term(h.clone());
+    residualize_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv).map_err(|_| no_zero())?;
+    if axes != POISSON_PAIR.map(|a| a as u8) {
+        let compressible = |axis: u8| axis == 0 || axis == 2;
+        let (cu, cv) = (compressible(axes[0]), compressible(axes[1]));
+        zero_compressed(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv, &mut h.duv, cu, cv);
+    }
+    Ok((term(h), regularized))
 }
 
 /// The regularized plane `f*` moved onto the fitted 1D terms: `f* + g(u) + h(v)` with `g`, `h`
@@ -267,9 +293,13 @@ fn fit_2d(
 ///
 /// The residual (A.38) does not change (it removes functions of one variable), but the energy
 /// on the plane, `f0 + f_u + f_v + r`, is now this `f*` up to re-interpolating `f_u`, `f_v` on
-/// the plane's control points, so the marching (A.36) acts on the energy the material shows.
+/// the plane's control points and up to the axis lines' slopes that the monotone step (App. B)
+/// then projects, so the marching (A.36) acts on nearly the energy the material shows.
 /// Marching the plane's own `f*` left that sum with the difference between two fits of the
 /// same axis data on different control points, which made second minima where `f*` is flat.
+/// (Putting the 1D terms' slopes back on the axis lines after the monotone step, tried, removes
+/// some of the sum's second minima but breaks App. B's guarantee in the cells beside the axes:
+/// `f*` itself then has second minima, see README "Spline fits".)
 fn move_onto_1d_terms(
     h: &mut HermiteGrid,
     [u_knots, v_knots]: [&[f64]; 2],
@@ -298,53 +328,6 @@ fn move_onto_1d_terms(
             h.values[n] += gi + hj;
             h.du[n] += dgi;
             h.dv[n] += dhj;
-        }
-    }
-}
-
-/// The slopes along a plane's axis lines (`p^u` on the row `v = 0`, `p^v` on the column
-/// `u = 0`), kept across the monotone step (App. B) at the interior control points.
-///
-/// After [`move_onto_1d_terms`] these are the 1D terms' slopes, and the residual (A.38)
-/// subtracts the axis lines from the whole plane, so that the material's energy on the plane is
-/// the plane's patch plus the difference between each 1D term and the plane's axis line. The
-/// monotone step projects the slopes of every node, the axis lines' included (to make the cells
-/// beside them monotone); left there, that difference, zero in value at the control points but
-/// not in slope, entered every line of the plane and made second minima where the plane is
-/// flat (the thesis-size stockinette: on 17 of the 304 lines [`crate::shape`] checks, 10 with
-/// the slopes restored). Restored, it is zero but in the outermost intervals (see
-/// [`AxisLineSlopes::restore`]), and the cells beside the axis lines may lose App. B's
-/// guarantee.
-struct AxisLineSlopes {
-    /// `p^u` on the row `v = 0`, per `u` control point.
-    row: Vec<f64>,
-    /// `p^v` on the column `u = 0`, per `v` control point.
-    column: Vec<f64>,
-    nu: usize,
-    origin: [usize; 2],
-}
-
-impl AxisLineSlopes {
-    fn of(h: &HermiteGrid, [nu, nv]: [usize; 2], [i0, j0]: [usize; 2]) -> Self {
-        let row = h.du[j0 * nu..(j0 + 1) * nu].to_vec();
-        let column = (0..nv).map(|j| h.dv[j * nu + i0]).collect();
-        Self { row, column, nu, origin: [i0, j0] }
-    }
-
-    /// Put back the slopes of the axis lines that are 1D terms (`[u, v]`), but at their ends:
-    /// the boundary slopes set the extrapolation (A.3.5), which the monotone step makes
-    /// increasing across the boundary too.
-    fn restore(&self, h: &mut HermiteGrid, [along_u, along_v]: [bool; 2]) {
-        let (nu, nv, [i0, j0]) = (self.nu, self.column.len(), self.origin);
-        if along_u {
-            for i in 1..nu - 1 {
-                h.du[j0 * nu + i] = self.row[i];
-            }
-        }
-        if along_v {
-            for j in 1..nv - 1 {
-                h.dv[j * nu + i0] = self.column[j];
-            }
         }
     }
 }

@@ -30,7 +30,7 @@ pub mod shape;
 pub mod synthetic;
 
 pub use difference::diff_spline_materials;
-pub use fit::{FitError, TermError, fit_errors, fit_grid};
+pub use fit::{FitError, RegularizedFit, TermError, fit_errors, fit_grid, fit_grid_with_regularized_terms};
 pub use material::{EnergyJet, SplineMaterial};
 pub use ranges::{RangeError, SampledRanges, sampled_ranges};
-pub use shape::{TermShape, term_shapes};
+pub use shape::{TermShape, regularized_term_shapes, term_shapes};

@@ -1,13 +1,19 @@
-//! Checks of a fitted material's shape: each quasiconvexified term has a single minimum
-//! (A.36). For a 1D term the fitted energy along its axis, for a marched 2D term the fitted
-//! energy on its plane (`f0 + f_u + f_v + f_uv`, the regularized `f*` of A.3.6 the marching acts
-//! on) along every line through its control points, halfway between them and along the edges of
+//! Checks of a fitted material's shape (A.36), along the lines of each marched term's axis or
+//! plane: every line through its control points, halfway between them and along the edges of
 //! the checked region, over 1.5 times the sampled range.
+//!
+//! - [`regularized_term_shapes`]: each quasiconvexified term has a single minimum, the thesis'
+//!   criterion ("we want to enforce that individual terms `f_i` and `f_ij` have a single
+//!   well-defined minimum", Sec. 4.1.2): a 1D term along its axis, a 2D term's regularized fit
+//!   `f*_uv` (A.3.6) on its plane.
+//! - [`term_shapes`]: the same of the material's energy on each plane, `f0 + f_u + f_v + f_uv`,
+//!   the aggregate of the terms, which "can still produce multiple minima" (ibid.).
 
 use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values};
-use yarnhom_artifacts::{Grid, Spline, StrainSample};
+use yarnhom_artifacts::{BicubicTerm, Grid, GridTerm, Spline, StrainSample};
 
 use crate::SplineMaterial;
+use crate::hermite::Bicubic;
 
 /// Points per line.
 const POINTS: usize = 1501;
@@ -64,25 +70,76 @@ fn value_range(ys: &[f64]) -> f64 {
     ys.iter().copied().fold(f64::NEG_INFINITY, f64::max) - ys.iter().copied().fold(f64::INFINITY, f64::min)
 }
 
-/// The shape check of every quasiconvexified term of `spline` over the ranges of `grid`;
-/// plateaus up to `relative_tolerance` of a term's energy range are allowed.
+/// The shape check of the material's energy on every marched term's axis or plane, over the
+/// ranges of `grid`; plateaus up to `relative_tolerance` of a term's energy range are allowed.
 pub fn term_shapes(grid: &Grid, spline: &Spline, relative_tolerance: f64) -> Vec<TermShape> {
     let material = SplineMaterial::from(spline);
+    shapes(grid, spline, relative_tolerance, |term, values| {
+        material.energy_at(&strain_along(&term.axes, values))
+    })
+}
+
+/// The shape check of every quasiconvexified term of a fit: its 1D terms along their axes and
+/// its regularized 2D fits `regularized_2d` (see [`crate::fit::RegularizedFit`]) on their planes,
+/// over the ranges of `grid`; tolerance as in [`term_shapes`].
+pub fn regularized_term_shapes(
+    grid: &Grid,
+    spline: &Spline,
+    regularized_2d: &[BicubicTerm],
+    relative_tolerance: f64,
+) -> Vec<TermShape> {
+    let material = SplineMaterial::from(spline);
+    let patches: Vec<([u8; 2], Bicubic)> = regularized_2d
+        .iter()
+        .map(|t| {
+            let patch = Bicubic {
+                u_knots: t.u_knots.clone(),
+                v_knots: t.v_knots.clone(),
+                values: t.values.clone(),
+                du: t.du.clone(),
+                dv: t.dv.clone(),
+                duv: t.duv.clone(),
+            };
+            (t.axes, patch)
+        })
+        .collect();
+    let scale = |axis: u8| spline.strain_scale[axis as usize];
+    shapes(grid, spline, relative_tolerance, |term, values| match term.axes.as_slice() {
+        &[u, v] => match patches.iter().find(|(axes, _)| *axes == [u, v]) {
+            Some((_, patch)) => patch.value(values[0] / scale(u), values[1] / scale(v)),
+            // Reported as a term without a finite energy.
+            None => f64::NAN,
+        },
+        _ => material.energy_at(&strain_along(&term.axes, values)),
+    })
+}
+
+/// The shape check of `energy(term, strain values on its axes)` along each marched term's lines.
+fn shapes(
+    grid: &Grid,
+    spline: &Spline,
+    relative_tolerance: f64,
+    energy: impl Fn(&GridTerm, &[f64]) -> f64,
+) -> Vec<TermShape> {
     grid.terms
         .iter()
         .filter(|t| t.axes.as_slice() != POISSON_PAIR)
         .map(|term| {
             let ranges: Vec<Vec<f64>> =
                 term.values.iter().map(|v| linspace(1.5 * v[0], 1.5 * v[v.len() - 1], POINTS)).collect();
-            let energy = |values: &[f64]| material.energy_at(&strain_along(&term.axes, values));
             let lines = checked_lines(spline, &term.axes, &ranges);
-            let all: Vec<f64> = lines.iter().flat_map(|l| l.iter().map(|p| energy(p))).collect();
+            let along = |line: &Vec<Vec<f64>>| line.iter().map(|p| energy(term, p)).collect::<Vec<f64>>();
+            let all: Vec<f64> = lines.iter().flat_map(along).collect();
             let tol = relative_tolerance * value_range(&all);
             let violations = lines
                 .iter()
                 .filter_map(|line| {
-                    let ys: Vec<f64> = line.iter().map(|p| energy(p)).collect();
-                    unimodality_violation(&ys, tol).map(|i| describe(&term.axes, &line[i]))
+                    let ys = along(line);
+                    match ys.iter().position(|y| !y.is_finite()) {
+                        Some(i) => Some(format!("no finite energy at {}", at(&term.axes, &line[i]))),
+                        None => unimodality_violation(&ys, tol)
+                            .map(|i| format!("a second minimum near {}", at(&term.axes, &line[i]))),
+                    }
                 })
                 .collect();
             TermShape { term: term.name(), lines: lines.len(), violations }
@@ -113,10 +170,11 @@ fn checked_lines(spline: &Spline, axes: &[u8], ranges: &[Vec<f64>]) -> Vec<Vec<V
     along_u.chain(along_v).collect()
 }
 
-fn describe(axes: &[u8], point: &[f64]) -> String {
+/// A point of a term's plane or axis, e.g. `sx = 0.1000, kx = -20.0000`.
+fn at(axes: &[u8], point: &[f64]) -> String {
     let name = |a: u8| AXIS_NAMES.get(a as usize).copied().unwrap_or("?");
     let parts: Vec<String> = axes.iter().zip(point).map(|(&a, x)| format!("{} = {x:.4}", name(a))).collect();
-    format!("a second minimum near {}", parts.join(", "))
+    parts.join(", ")
 }
 
 #[cfg(test)]
