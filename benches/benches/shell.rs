@@ -1,7 +1,8 @@
 //! Seconds per implicit time step of the thin-shell simulator on the published 30 cm stretch
 //! and drape scenes (built-ins `stretch-x`, `drape`) at 50 x 50 = 2500 vertices, with the
 //! published ARCSim-HYLC stockinette material (`stock1.json`), one thread (`RAYON_NUM_THREADS=1`
-//! gives the single-core figure) or all.
+//! gives the single-core figure) or all, with either Newton matrix (`projected`, the default,
+//! and `bending-gauss-newton`).
 //! Compared with: thesis Table 4.2, HYLC in ARCSim 0.41-1.15 s per step at 2.1k-4.4k vertices;
 //! target 10x faster, under 0.05 s per step on one core.
 //! Each sample is the mean over the same 10 steps (steps 11-20: the cloth is moving), restarted
@@ -13,6 +14,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::simulate::prepare;
 use yarnhom_shell::{Scene, ShellMaterial, Simulation};
 
@@ -42,8 +44,13 @@ fn run_window(sim: &mut Simulation, state: &State) -> (Duration, u32) {
 fn bench_steps(c: &mut Criterion) {
     let mut g = c.benchmark_group("shell time step");
     g.sample_size(10);
-    for name in ["stretch-x", "drape"] {
-        let scene = Scene::builtin(name).expect("builtin");
+    let matrices =
+        [(NewtonMatrix::Projected, "projected"), (NewtonMatrix::BendingGaussNewton, "bending-gauss-newton")];
+    for (name, (matrix, matrix_name)) in
+        ["stretch-x", "drape"].into_iter().flat_map(|n| matrices.map(|m| (n, m)))
+    {
+        let mut scene = Scene::builtin(name).expect("builtin");
+        scene.newton_matrix = matrix;
         let mut sim = prepare(&scene, stock()).expect("scene");
         for _ in 0..SETTLE {
             sim.step().expect("step");
@@ -51,7 +58,7 @@ fn bench_steps(c: &mut Criterion) {
         let state = (sim.positions.clone(), sim.velocities.clone(), sim.time_s);
         let (_, iterations) = run_window(&mut sim, &state);
         eprintln!(
-            "{name}: {} vertices, {} triangles, dt {} s, {:.1} Newton iterations per step (steps {}-{}), {} threads",
+            "{name}, {matrix_name}: {} vertices, {} triangles, dt {} s, {:.1} Newton iterations per step (steps {}-{}), {} threads",
             sim.positions.len(),
             sim.model.mesh.triangles.len(),
             scene.dt_s(),
@@ -60,7 +67,7 @@ fn bench_steps(c: &mut Criterion) {
             SETTLE + WINDOW as usize,
             rayon::current_num_threads()
         );
-        g.bench_function(format!("{name}, 2500 vertices, stock1"), |b| {
+        g.bench_function(format!("{name}, 2500 vertices, stock1, {matrix_name}"), |b| {
             b.iter_custom(|samples| (0..samples).map(|_| run_window(&mut sim, &state).0).sum())
         });
     }

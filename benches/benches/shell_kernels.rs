@@ -3,7 +3,7 @@
 //! - the discrete forms (4.4)-(4.7) with their gradient and Hessian over the 18 stencil DOFs,
 //!   and with their gradient only (what a gradient or a handle force needs),
 //! - the whole element: forms, the spline material's derivatives and the A.5 composition, with
-//!   and without the element Hessian,
+//!   and without the element Hessian, and with the Gauss-Newton bending matrix instead,
 //! - the eigenvalue clamp of its 18 x 18 Hessian (Sec. 4.2),
 //! - the edge-hinge bending energy (6.4) with derivatives.
 //!
@@ -53,6 +53,9 @@ fn bench_kernels(c: &mut Criterion) {
     });
     g.bench_function("spline element: forms, material jet, A.5 composition", |b| {
         b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), true))
+    });
+    g.bench_function("spline element, Gauss-Newton bending matrix (no forms' Hessians)", |b| {
+        b.iter(|| model.triangle_element_gauss_newton(t, std::hint::black_box(&x)))
     });
     g.bench_function("spline element, energy and gradient only", |b| {
         b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), false))

@@ -224,7 +224,7 @@ impl SwatchTest {
     /// The rig's readings of the equilibrium `x`.
     fn read(&self, model: &ElasticModel, x: &[Vector3<f64>], clamp_stretch: f64) -> SimulatedReading {
         let mut a = Assembly::new(3 * x.len());
-        model.assemble(x, false, &mut a);
+        model.assemble(x, None, &mut a);
         let force_n: f64 = self.pulled.iter().map(|&v| a.gradient[3 * v]).sum();
         let distance = |m: &[Marker; 2]| (m[1].position(x) - m[0].position(x)).norm();
         let rest_distance = |m: &[Marker; 2]| (m[1].position(&self.rest) - m[0].position(&self.rest)).norm();

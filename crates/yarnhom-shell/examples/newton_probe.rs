@@ -1,6 +1,7 @@
 //! Newton convergence of the shell integrator on a built-in scene with a published material:
 //! per step the iterations, line-search halvings, final residual and wall time.
-//! `cargo run --release -p yarnhom-shell --example newton_probe -- SCENE MATERIAL N STEPS [TOLERANCE_M]`
+//! `cargo run --release -p yarnhom-shell --example newton_probe -- SCENE MATERIAL N STEPS [TOLERANCE_M]
+//! [projected|bending-gauss-newton]`
 
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
@@ -20,6 +21,10 @@ fn main() {
     scene.vertices = [n, n];
     if let Some(tolerance) = args.get(5).and_then(|a| a.parse().ok()) {
         scene.tolerance_m = tolerance;
+    }
+    if let Some(matrix) = args.get(6) {
+        scene.newton_matrix = serde_json::from_value(serde_json::Value::String(matrix.clone()))
+            .expect("projected or bending-gauss-newton");
     }
     let mut sim = prepare(&scene, ShellMaterial::spline(SplineMaterial::from(&spline))).expect("scene");
     for _ in 0..steps {

@@ -5,6 +5,7 @@
 
 use nalgebra::{SMatrix, SVector, Vector3};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 use crate::forms::{
     RestTriangle, Stencil, first_form_of, first_form_with_derivatives, forms, forms_with_derivatives,
@@ -98,14 +99,15 @@ impl ElementSink for Assembly {
     }
 }
 
-/// A symmetric element Hessian `H` with its negative eigenvalue part `N = Σ_{λ<0} λ v vᵀ`
-/// (`None` when `H` is positive semidefinite): the clamped Hessian `H - N` drops the negative
-/// curvature, the absolute one `H - 2N` flips its sign (Chen et al. 2024, "Trust-region
-/// eigenvalue filtering for projected Newton"); both are positive semidefinite.
+/// A symmetric element matrix `H` (the element Hessian, or its [`NewtonMatrix`] approximation)
+/// with its negative eigenvalue part `N = Σ_{λ<0} λ v vᵀ` (`None` when `H` is positive
+/// semidefinite): the clamped matrix `H - N` drops the negative curvature, the absolute one
+/// `H - 2N` flips its sign (Chen et al. 2024, "Trust-region eigenvalue filtering for projected
+/// Newton"); both are positive semidefinite.
 #[derive(Debug, Clone)]
 pub struct SplitHessian<const N: usize> {
-    /// The exact Hessian.
-    pub exact: SMatrix<f64, N, N>,
+    /// The matrix.
+    pub matrix: SMatrix<f64, N, N>,
     /// Its negative eigenvalue part, if any.
     pub negative: Option<SMatrix<f64, N, N>>,
 }
@@ -114,18 +116,34 @@ impl<const N: usize> SplitHessian<N> {
     /// `H` with its negative eigenvalues set to zero.
     pub fn clamped(&self) -> SMatrix<f64, N, N> {
         match &self.negative {
-            Some(n) => self.exact - n,
-            None => self.exact,
+            Some(n) => self.matrix - n,
+            None => self.matrix,
         }
     }
 
     /// `H` with its eigenvalues replaced by their absolute values.
     pub fn absolute(&self) -> SMatrix<f64, N, N> {
         match &self.negative {
-            Some(n) => self.exact - 2.0 * n,
-            None => self.exact,
+            Some(n) => self.matrix - 2.0 * n,
+            None => self.matrix,
         }
     }
+}
+
+/// The element matrices a Newton step takes, each made positive semidefinite per element.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NewtonMatrix {
+    /// The exact element Hessians (A.44), as Sec. 4.2 takes them.
+    #[default]
+    Projected,
+    /// (A.44) without the curvature forms' second derivatives weighted by the bending stress,
+    /// `Σ_k ∂Ψ/∂II_k ∇²II_k`: Gauss-Newton in the bending strains. That term holds every
+    /// negative eigenvalue of the element Hessians of a curling stockinette (the bending stress
+    /// is not zero on the flat cloth), so most elements need no eigensolver, and the six 18 x 18
+    /// Hessians of the forms are not computed; Newton takes about as many iterations. The
+    /// gradient, and so the solution, is unchanged.
+    BendingGaussNewton,
 }
 
 /// Whether a symmetric matrix is positive semidefinite up to rounding: a Cholesky
@@ -141,7 +159,7 @@ macro_rules! split_hessian {
         /// semidefinite skip the eigensolver.
         pub fn $name(h: SMatrix<f64, $n, $n>) -> SplitHessian<$n> {
             if is_psd(&h) {
-                return SplitHessian { exact: h, negative: None };
+                return SplitHessian { matrix: h, negative: None };
             }
             let eigen = nalgebra::SymmetricEigen::new(h);
             let mut negative = SMatrix::<f64, $n, $n>::zeros();
@@ -150,7 +168,7 @@ macro_rules! split_hessian {
                     negative += *l * v * v.transpose();
                 }
             }
-            SplitHessian { exact: h, negative: Some(negative) }
+            SplitHessian { matrix: h, negative: Some(negative) }
         }
     };
 }
@@ -282,13 +300,14 @@ impl ElasticModel {
         triangles.chain(hinges).collect()
     }
 
-    /// Energy, gradient and, if `hessian`, the element Hessians with their negative parts, handed
-    /// to `out` in element order. Elements are evaluated in parallel, in chunks, and handed on in
-    /// order (identical for any thread count).
-    pub fn assemble(&self, x: &[Vector3<f64>], hessian: bool, out: &mut impl ElementSink) {
+    /// Energy, gradient and, if `matrix` asks for them, the element matrices with their negative
+    /// parts, handed to `out` in element order. Elements are evaluated in parallel, in chunks,
+    /// and handed on in order (identical for any thread count).
+    pub fn assemble(&self, x: &[Vector3<f64>], matrix: Option<NewtonMatrix>, out: &mut impl ElementSink) {
         let triangles = self.rest.len();
+        let hessian = matrix.is_some();
         if self.material.uses_second_form() {
-            hand_on(triangles, 0, out, |t| (self.stencil_vertices(t), self.triangle_element(t, x, hessian)));
+            hand_on(triangles, 0, out, |t| (self.stencil_vertices(t), self.triangle_element(t, x, matrix)));
         } else {
             hand_on(triangles, 0, out, |t| {
                 (self.mesh.triangles[t].map(Some), self.membrane_element(t, x, hessian))
@@ -320,10 +339,35 @@ impl ElasticModel {
         (area * jet.value, gradient, h)
     }
 
-    /// (4.8) with (A.43)-(A.44), the Hessian with its negative part.
-    fn triangle_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> SplitElement<18> {
-        let (e, g, h) = self.triangle_element_exact(t, x, hessian);
+    /// (4.8) with (A.43)-(A.44), the element matrix `matrix` asks for with its negative part.
+    fn triangle_element(
+        &self,
+        t: usize,
+        x: &[Vector3<f64>],
+        matrix: Option<NewtonMatrix>,
+    ) -> SplitElement<18> {
+        let (e, g, h) = match matrix {
+            Some(NewtonMatrix::BendingGaussNewton) => self.triangle_element_gauss_newton(t, x),
+            _ => self.triangle_element_exact(t, x, matrix.is_some()),
+        };
         (e, g, h.map(split_hessian_18))
+    }
+
+    /// (4.8) with (A.43) and the [`NewtonMatrix::BendingGaussNewton`] matrix
+    /// `A (Jᵀ ∇²Ψ J + Σ_{k ∈ I} ∂Ψ/∂I_k ∇² I_k)`, the first form's Hessians being those of the
+    /// triangle's 9 DOFs.
+    pub fn triangle_element_gauss_newton(&self, t: usize, x: &[Vector3<f64>]) -> Element<18> {
+        let rest = &self.rest[t];
+        let area = rest.rest_area;
+        let forms = forms_with_gradient(rest, &self.stencil(t, x));
+        let jet = self.material.jet(forms.first, forms.second);
+        let mut h = forms.gradient.transpose() * jet.hessian * forms.gradient;
+        let first = first_form_with_derivatives(rest, &self.mesh.triangles[t].map(|v| x[v as usize]));
+        let mut triangle = h.fixed_view_mut::<9, 9>(0, 0);
+        for (k, d2i) in first.hessian.iter().enumerate() {
+            triangle += jet.gradient[k] * d2i;
+        }
+        (area * jet.value, area * forms.gradient.transpose() * jet.gradient, Some(area * h))
     }
 
     /// (4.8) with (A.43)-(A.44): `E = A Ψ(z(q))`, `∇E = A Jᵀ ∇Ψ`,
@@ -384,7 +428,7 @@ mod tests {
         let model = ElasticModel::new(mesh.clone(), stvk());
         let x = deformed(&mesh);
         let mut a = Assembly::new(3 * x.len());
-        model.assemble(&x, false, &mut a);
+        model.assemble(&x, None, &mut a);
         assert!((a.energy - model.energy(&x)).abs() < 1e-12 * a.energy.abs().max(1.0));
         let h = 1e-7;
         for dof in 0..3 * x.len() {
@@ -413,14 +457,14 @@ mod tests {
         for t in 0..mesh.triangles.len() {
             let (e18, g18, h18) = model.triangle_element_exact(t, &x, true);
             let (e9, g9, h9) = model.membrane_element(t, &x, true);
-            let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for").exact);
+            let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for").matrix);
             assert!((e18 - e9).abs() < 1e-15 * e18.abs().max(1.0));
             assert!((g18.fixed_rows::<9>(0) - g9).amax() < 1e-12 * g9.amax().max(1.0));
             assert!(g18.fixed_rows::<9>(9).amax() == 0.0);
             assert!((h18.fixed_view::<9, 9>(0, 0) - h9).amax() < 1e-9 * h9.amax().max(1.0), "triangle {t}");
         }
         let mut a = Assembly::new(3 * x.len());
-        model.assemble(&x, false, &mut a);
+        model.assemble(&x, None, &mut a);
         assert!((a.energy - model.energy(&x)).abs() < 1e-12 * a.energy.abs().max(1.0));
     }
 
@@ -463,9 +507,9 @@ mod tests {
         assert!(split_hessian_18(spd).negative.is_none());
     }
 
-    #[test]
-    fn spline_element_derivatives_match_finite_differences() {
-        // The published honeycomb on a doubly curved, sheared, stretched interior stencil.
+    /// The published honeycomb on a doubly curved, sheared, stretched mesh, and an interior
+    /// triangle of it.
+    fn honeycomb_on_a_curved_mesh() -> (ElasticModel, Vec<Vector3<f64>>, usize) {
         let path = format!("{}/../../../shared/data/hylc-materials/honey1.json", env!("CARGO_MANIFEST_DIR"));
         let spline = yarnhom_artifacts::arcsim::read_spline(std::path::Path::new(&path)).expect("published");
         let material = ShellMaterial::spline(yarnhom_fit::SplineMaterial::from(&spline));
@@ -485,6 +529,12 @@ mod tests {
         let t = (0..mesh.triangles.len())
             .find(|&t| mesh.neighbours[t].iter().all(Option::is_some))
             .expect("interior");
+        (model, x, t)
+    }
+
+    #[test]
+    fn spline_element_derivatives_match_finite_differences() {
+        let (model, x, t) = honeycomb_on_a_curved_mesh();
         let vertices = model.stencil_vertices(t).map(|v| v.expect("interior") as usize);
         let (_, gradient, hessian) = model.triangle_element_exact(t, &x, true);
         let hessian = hessian.expect("asked for");
@@ -514,5 +564,20 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_bending_gauss_newton_matrix_drops_only_the_curvature_forms_second_derivatives() {
+        let (model, x, t) = honeycomb_on_a_curved_mesh();
+        let (e, g, h) = model.triangle_element_exact(t, &x, true);
+        let (e_gn, g_gn, h_gn) = model.triangle_element_gauss_newton(t, &x);
+        assert_eq!((e, g), (e_gn, g_gn));
+        let (h, h_gn) = (h.expect("asked for"), h_gn.expect("asked for"));
+        let forms = forms_with_derivatives(&model.rest[t], &model.stencil(t, &x));
+        let jet = model.material.jet(forms.first, forms.second);
+        let dropped: SMatrix<f64, 18, 18> =
+            (3..6).map(|k| model.rest[t].rest_area * jet.gradient[k] * forms.hessian[k]).sum();
+        assert!(dropped.amax() > 1e-3 * h.amax(), "the curved cloth has a bending stress");
+        assert!((h - dropped - h_gn).amax() < 1e-10 * h.amax(), "{}", (h - dropped - h_gn).amax());
     }
 }

@@ -8,7 +8,9 @@
 //! Hessians enter the Newton matrix with their eigenvalues replaced by their absolute values
 //! (Chen et al. 2024; from the same states of the published stretch and drape scenes, about a
 //! fifth fewer Newton iterations than with the eigenvalues clamped to zero), which changes the
-//! path to the minimum of `Φ`, not the minimum. Rayleigh damping `D = α M + β K_n` (`K_n` the
+//! path to the minimum of `Φ`, not the minimum. [`NewtonMatrix::BendingGaussNewton`] takes, after
+//! a step's first iteration, Gauss-Newton element matrices in the bending strains instead,
+//! which need the eigensolver far less often (same `Φ`, same minimum). Rayleigh damping `D = α M + β K_n` (`K_n` the
 //! elastic Hessian clamped to PSD per element at the start of the step) enters as
 //! `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
 //! Handle vertices follow their scripted positions and are removed from the unknowns. The
@@ -22,7 +24,7 @@ use std::time::Instant;
 use nalgebra::{Matrix3, Vector3};
 
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
-use crate::elastic::{Assembly, ElasticModel};
+use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;
 use crate::newton_matrix::{HessianPattern, NewtonAssembly};
 
@@ -76,6 +78,9 @@ pub struct Dynamics {
     pub max_newton_iterations: u32,
     /// Newton stops when the largest position update is below this (m).
     pub tolerance_m: f64,
+    /// The element matrices of the Newton matrix after a step's first iteration (which takes
+    /// the projected Hessians, and with them the stiffness damping matrix).
+    pub newton_matrix: NewtonMatrix,
 }
 
 /// What one step did.
@@ -195,7 +200,7 @@ impl Simulation {
     /// over its vertices (the force the handle must apply to hold them is its negative).
     pub fn handle_force_n(&self, k: usize) -> Vector3<f64> {
         let mut a = Assembly::new(3 * self.positions.len());
-        self.model.assemble(&self.positions, false, &mut a);
+        self.model.assemble(&self.positions, None, &mut a);
         self.handles[k]
             .vertices
             .iter()
@@ -337,12 +342,15 @@ impl Simulation {
     }
 
     /// Gradient and Newton matrix of `Φ`. On the step's first iteration the clamped elastic
-    /// Hessian is also kept, scaled by `β`, as the stiffness damping matrix `β K_n`.
+    /// Hessian is also kept, scaled by `β`, as the stiffness damping matrix `β K_n`, and that
+    /// iteration takes the projected Hessians whatever [`Dynamics::newton_matrix`] says, so that
+    /// `Φ` does not depend on it.
     fn assemble(&self, x: &[Vector3<f64>], terms: &mut StepTerms, first: bool, a: &mut NewtonAssembly) {
         let h = self.dynamics.dt_s;
         let beta = self.dynamics.stiffness_damping;
         a.clear(first && beta > 0.0);
-        self.model.assemble(x, true, a);
+        let matrix = if first { NewtonMatrix::Projected } else { self.dynamics.newton_matrix };
+        self.model.assemble(x, Some(matrix), a);
         if let Some(clamped) = a.clamped.take() {
             terms.stiffness_damping = clamped.iter().map(|v| beta * v).collect();
         }

@@ -239,7 +239,7 @@ mod tests {
         let mut a = NewtonAssembly::new(&pattern);
         a.clear(true);
         let h = SplitHessian::<6> {
-            exact: nalgebra::SMatrix::from_fn(|i, j| (1 + i + j) as f64),
+            matrix: nalgebra::SMatrix::from_fn(|i, j| (1 + i + j) as f64),
             negative: None,
         };
         a.add(0, &elements[0], 1.0, &nalgebra::SVector::<f64, 6>::repeat(1.0), Some(&h));
@@ -248,7 +248,7 @@ mod tests {
         let mut dense = nalgebra::DMatrix::<f64>::zeros(9, 9);
         for offset in [0, 3] {
             let mut block = dense.view_mut((offset, offset), (6, 6));
-            block += h.exact;
+            block += h.matrix;
         }
         let v: Vec<f64> = (0..9).map(|i| (i as f64).sin()).collect();
         let expected = &dense * nalgebra::DVector::from_column_slice(&v);
@@ -275,7 +275,7 @@ mod tests {
 
     #[test]
     fn the_pattern_assembly_is_the_triplet_assembly() {
-        use crate::elastic::{Assembly, ElasticModel};
+        use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
         use crate::material::{HingeBending, ShellMaterial};
         use crate::mesh::ShellMesh;
         let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
@@ -301,9 +301,9 @@ mod tests {
             let model = ElasticModel::new(mesh.clone(), material);
             let pattern = HessianPattern::new(x.len(), &model.element_vertices());
             let (mut triplets, mut a) = (Assembly::new(3 * x.len()), NewtonAssembly::new(&pattern));
-            model.assemble(&x, true, &mut triplets);
+            model.assemble(&x, Some(NewtonMatrix::Projected), &mut triplets);
             a.clear(true);
-            model.assemble(&x, true, &mut a);
+            model.assemble(&x, Some(NewtonMatrix::Projected), &mut a);
             assert!(triplets.triplets.iter().any(|t| t.2 != 0.0));
             let expected = dense_from_triplets(3 * x.len(), &triplets.triplets);
             // The recorded clamped Hessian is the triplets' matrix.

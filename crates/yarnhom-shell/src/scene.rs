@@ -10,6 +10,7 @@ use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use crate::contact::{ContactSettings, Obstacle};
+use crate::elastic::NewtonMatrix;
 use crate::integrator::{Dynamics, Handle, Motion};
 use crate::mesh::ShellMesh;
 
@@ -48,6 +49,10 @@ pub struct Scene {
     pub max_newton_iterations: u32,
     /// Newton tolerance on the position update (m).
     pub tolerance_m: f64,
+    /// The element matrices of the Newton matrix (`projected`, the default, or
+    /// `bending-gauss-newton`).
+    #[serde(default)]
+    pub newton_matrix: NewtonMatrix,
 }
 
 /// Which vertices a handle holds.
@@ -131,6 +136,7 @@ impl Scene {
             },
             max_newton_iterations: 30,
             tolerance_m: 1e-4,
+            newton_matrix: NewtonMatrix::Projected,
         };
         let bar = |side: u8, motion: usize| HandleSpec::Bar {
             side,
@@ -291,6 +297,7 @@ impl Scene {
             stiffness_damping: self.stiffness_damping,
             max_newton_iterations: self.max_newton_iterations,
             tolerance_m: self.tolerance_m,
+            newton_matrix: self.newton_matrix,
         }
     }
 }

@@ -6,7 +6,7 @@
 use nalgebra::Vector3;
 use yarnhom_rve::linear::SpdSolver;
 
-use crate::elastic::{Assembly, ElasticModel};
+use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;
 
 /// When to stop.
@@ -65,7 +65,7 @@ pub fn solve_static(
     let mut energy = potential(x);
     for iteration in 0..settings.max_iterations {
         a.clear();
-        model.assemble(x, true, &mut a);
+        model.assemble(x, Some(NewtonMatrix::Projected), &mut a);
         for (v, f) in loads.iter().enumerate() {
             for k in 0..3 {
                 a.gradient[3 * v + k] -= f[k];
@@ -154,7 +154,7 @@ mod tests {
                 .expect("solves");
         assert!(stats.converged, "{stats:?}");
         let mut a = Assembly::new(3 * x.len());
-        model.assemble(&x, false, &mut a);
+        model.assemble(&x, None, &mut a);
         let (mut left, mut right) = (0.0, 0.0);
         for (v, m) in mesh.material.iter().enumerate() {
             if !fixed[3 * v] {

@@ -5,6 +5,7 @@
 use nalgebra::Vector3;
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::scene::HandleSpec;
 use yarnhom_shell::simulate::prepare;
 use yarnhom_shell::{Scene, ShellMaterial, Simulation};
@@ -155,5 +156,38 @@ fn a_patch_draped_on_a_sphere_comes_to_rest_without_penetrating_it() {
         sim.kinetic_energy() < 0.05 * peak,
         "at rest: kinetic {:.2e} J vs peak {peak:.2e} J",
         sim.kinetic_energy()
+    );
+}
+
+#[test]
+fn both_newton_matrices_reach_the_same_states() {
+    // The Newton matrix changes the path to each step's minimum of `Φ`, not `Φ` (the first
+    // iteration of a step, which also sets the stiffness damping, is projected either way): the
+    // curling stockinette, stretched and hanging, takes the same states with the projected
+    // Hessians and with Gauss-Newton in the bending strains, to the Newton tolerance (1e-6 m).
+    let run = |matrix: NewtonMatrix| {
+        let mut s = scene("stretch-x", 11, 2);
+        s.newton_matrix = matrix;
+        let mut sim = prepare(&s, published("stock1")).expect("scene");
+        let mut iterations = 0;
+        for _ in 0..12 {
+            let stats = sim.step().expect("step");
+            assert!(stats.converged, "{matrix:?}: {stats:?}");
+            iterations += stats.newton_iterations;
+        }
+        (sim.positions, iterations)
+    };
+    let (projected, projected_iterations) = run(NewtonMatrix::Projected);
+    let (gauss_newton, gauss_newton_iterations) = run(NewtonMatrix::BendingGaussNewton);
+    let largest = projected.iter().zip(&gauss_newton).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
+    assert!(largest < 1e-6, "largest difference {largest} m");
+    // And neither needs many more iterations than the other.
+    assert!(
+        gauss_newton_iterations <= 2 * projected_iterations,
+        "{gauss_newton_iterations} vs {projected_iterations}"
+    );
+    assert!(
+        projected_iterations <= 2 * gauss_newton_iterations,
+        "{projected_iterations} vs {gauss_newton_iterations}"
     );
 }
