@@ -9,6 +9,7 @@ use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Deserialize;
 use yarnhom_fit::SplineMaterial;
+use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::simulate::{FrameReport, run as run_scene};
 use yarnhom_shell::{HingeBending, Scene, ShellMaterial, Simulation, StvkNeoHookean};
 use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceMetadata};
@@ -51,6 +52,28 @@ pub struct SimulateArgs {
     /// Implicit time steps per frame (overrides the scene).
     #[arg(long)]
     pub steps_per_frame: Option<u32>,
+    /// The Newton matrix after each step's first iteration (overrides the scene): the projected
+    /// element Hessians (Sec. 4.2) or Gauss-Newton in the bending strains (faster; same states).
+    #[arg(long, value_enum)]
+    pub newton_matrix: Option<NewtonMatrixArg>,
+}
+
+/// [`NewtonMatrix`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum NewtonMatrixArg {
+    /// `projected`.
+    Projected,
+    /// `bending-gauss-newton`.
+    BendingGaussNewton,
+}
+
+impl From<NewtonMatrixArg> for NewtonMatrix {
+    fn from(arg: NewtonMatrixArg) -> Self {
+        match arg {
+            NewtonMatrixArg::Projected => NewtonMatrix::Projected,
+            NewtonMatrixArg::BendingGaussNewton => NewtonMatrix::BendingGaussNewton,
+        }
+    }
 }
 
 #[derive(Debug, Args)]
@@ -102,10 +125,12 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
         scene.vertices = [n, n];
     }
     scene.steps_per_frame = args.steps_per_frame.unwrap_or(scene.steps_per_frame);
+    scene.newton_matrix = args.newton_matrix.map_or(scene.newton_matrix, NewtonMatrix::from);
     let material = load_material(&args.material)?;
     let metadata = TraceMetadata::new("yarnhom shell simulate", env!("CARGO_PKG_VERSION"))
         .with_entry("scene", &args.scene)
-        .with_entry("material", args.material.display().to_string());
+        .with_entry("material", args.material.display().to_string())
+        .with_entry("newton_matrix", serde_json::to_value(scene.newton_matrix)?.as_str().unwrap_or_default());
     let mut trace = TraceSink::open(&args.output, &metadata)?;
     let total = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
     let bar = ProgressBar::new(total);

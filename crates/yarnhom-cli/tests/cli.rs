@@ -563,10 +563,31 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
             "1",
             "--resolution",
             "7",
+            "--newton-matrix",
+            "bending-gauss-newton",
         ],
         dir.path(),
     );
-    assert!(dir.path().join("s.mcap").exists());
+    let trace = std::fs::read(dir.path().join("s.mcap")).expect("trace");
+    let metadata = yarnhom_trace::read_metadata(&trace).expect("metadata");
+    assert_eq!(metadata[0].entries["newton_matrix"], "bending-gauss-newton");
+    let out = yarnhom(
+        &[
+            "shell",
+            "simulate",
+            "scene.json",
+            "--material",
+            &published,
+            "-o",
+            "t.mcap",
+            "--newton-matrix",
+            "exact",
+        ],
+        dir.path(),
+    );
+    assert!(
+        !out.status.success() && stderr(&out).contains("possible values: projected, bending-gauss-newton")
+    );
 
     // The Ch. 6 model (6.1), (6.4) from its JSON file.
     let ch6 = format!("{}/../../tools/materials/ch6-example.json", env!("CARGO_MANIFEST_DIR"));
