@@ -550,41 +550,17 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
     );
     let scene = ok(&["shell", "scene", "stretch-x", "-o", "scene.json"], dir.path());
     assert!(scene.contains("scene.json"));
-    ok(
-        &[
-            "shell",
-            "simulate",
-            "scene.json",
-            "--material",
-            &published,
-            "-o",
-            "s.mcap",
-            "--frames",
-            "1",
-            "--resolution",
-            "7",
-            "--newton-matrix",
-            "bending-gauss-newton",
-        ],
-        dir.path(),
-    );
+    let simulate_scene = |extra: &[&str]| {
+        let args = ["shell", "simulate", "scene.json", "--material", published.as_str(), "--frames", "1"];
+        yarnhom(&[&args[..], extra].concat(), dir.path())
+    };
+    let out =
+        simulate_scene(&["-o", "s.mcap", "--resolution", "7", "--newton-matrix", "bending-gauss-newton"]);
+    assert!(out.status.success(), "{}", stderr(&out));
     let trace = std::fs::read(dir.path().join("s.mcap")).expect("trace");
     let metadata = yarnhom_trace::read_metadata(&trace).expect("metadata");
     assert_eq!(metadata[0].entries["newton_matrix"], "bending-gauss-newton");
-    let out = yarnhom(
-        &[
-            "shell",
-            "simulate",
-            "scene.json",
-            "--material",
-            &published,
-            "-o",
-            "t.mcap",
-            "--newton-matrix",
-            "exact",
-        ],
-        dir.path(),
-    );
+    let out = simulate_scene(&["-o", "t.mcap", "--newton-matrix", "exact"]);
     assert!(
         !out.status.success() && stderr(&out).contains("possible values: projected, bending-gauss-newton")
     );

@@ -122,6 +122,20 @@ pub struct Bicubic {
     pub duv: Vec<f64>,
 }
 
+impl From<&yarnhom_artifacts::BicubicTerm> for Bicubic {
+    /// The patch of a stored 2D term (in normalized strains).
+    fn from(term: &yarnhom_artifacts::BicubicTerm) -> Self {
+        Self {
+            u_knots: term.u_knots.clone(),
+            v_knots: term.v_knots.clone(),
+            values: term.values.clone(),
+            du: term.du.clone(),
+            dv: term.dv.clone(),
+            duv: term.duv.clone(),
+        }
+    }
+}
+
 impl Bicubic {
     /// Value, gradient and Hessian at `(u, v)`.
     pub fn jet(&self, u: f64, v: f64) -> Jet2 {

@@ -76,14 +76,7 @@ impl From<&Spline> for SplineMaterial {
                 .map(|t| Term2d {
                     axes: [t.axes[0] as usize, t.axes[1] as usize],
                     scales: [scale(t.axes[0]), scale(t.axes[1])],
-                    patch: Bicubic {
-                        u_knots: t.u_knots.clone(),
-                        v_knots: t.v_knots.clone(),
-                        values: t.values.clone(),
-                        du: t.du.clone(),
-                        dv: t.dv.clone(),
-                        duv: t.duv.clone(),
-                    },
+                    patch: Bicubic::from(t),
                 })
                 .collect(),
         }

@@ -89,20 +89,8 @@ pub fn regularized_term_shapes(
     relative_tolerance: f64,
 ) -> Vec<TermShape> {
     let material = SplineMaterial::from(spline);
-    let patches: Vec<([u8; 2], Bicubic)> = regularized_2d
-        .iter()
-        .map(|t| {
-            let patch = Bicubic {
-                u_knots: t.u_knots.clone(),
-                v_knots: t.v_knots.clone(),
-                values: t.values.clone(),
-                du: t.du.clone(),
-                dv: t.dv.clone(),
-                duv: t.duv.clone(),
-            };
-            (t.axes, patch)
-        })
-        .collect();
+    let patches: Vec<([u8; 2], Bicubic)> =
+        regularized_2d.iter().map(|t| (t.axes, Bicubic::from(t))).collect();
     let scale = |axis: u8| spline.strain_scale[axis as usize];
     shapes(grid, spline, relative_tolerance, |term, values| match term.axes.as_slice() {
         &[u, v] => match patches.iter().find(|(axes, _)| *axes == [u, v]) {
