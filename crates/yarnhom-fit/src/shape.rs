@@ -116,18 +116,16 @@ fn shapes(
             let ranges: Vec<Vec<f64>> =
                 term.values.iter().map(|v| linspace(1.5 * v[0], 1.5 * v[v.len() - 1], POINTS)).collect();
             let lines = checked_lines(spline, &term.axes, &ranges);
-            let along = |line: &Vec<Vec<f64>>| line.iter().map(|p| energy(term, p)).collect::<Vec<f64>>();
-            let all: Vec<f64> = lines.iter().flat_map(along).collect();
-            let tol = relative_tolerance * value_range(&all);
+            let energies: Vec<Vec<f64>> =
+                lines.iter().map(|line| line.iter().map(|p| energy(term, p)).collect()).collect();
+            let tol = relative_tolerance * value_range(&energies.concat());
             let violations = lines
                 .iter()
-                .filter_map(|line| {
-                    let ys = along(line);
-                    match ys.iter().position(|y| !y.is_finite()) {
-                        Some(i) => Some(format!("no finite energy at {}", at(&term.axes, &line[i]))),
-                        None => unimodality_violation(&ys, tol)
-                            .map(|i| format!("a second minimum near {}", at(&term.axes, &line[i]))),
-                    }
+                .zip(&energies)
+                .filter_map(|(line, ys)| match ys.iter().position(|y| !y.is_finite()) {
+                    Some(i) => Some(format!("no finite energy at {}", at(&term.axes, &line[i]))),
+                    None => unimodality_violation(ys, tol)
+                        .map(|i| format!("a second minimum near {}", at(&term.axes, &line[i]))),
                 })
                 .collect();
             TermShape { term: term.name(), lines: lines.len(), violations }
