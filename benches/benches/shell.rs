@@ -2,7 +2,7 @@
 //! and drape scenes (built-ins `stretch-x`, `drape`) at 50 x 50 = 2500 vertices, with the
 //! published ARCSim-HYLC stockinette material (`stock1.json`), one thread (`RAYON_NUM_THREADS=1`
 //! gives the single-core figure) or all, with either Newton matrix (`projected`, the default,
-//! and `bending-gauss-newton`).
+//! and `gauss-newton`).
 //! Compared with: thesis Table 4.2, HYLC in ARCSim 0.41-1.15 s per step at 2.1k-4.4k vertices;
 //! target 10x faster, under 0.05 s per step on one core.
 //! Each sample is the mean over the same 10 steps (steps 11-20: the cloth is moving), restarted
@@ -44,8 +44,7 @@ fn run_window(sim: &mut Simulation, state: &State) -> (Duration, u32) {
 fn bench_steps(c: &mut Criterion) {
     let mut g = c.benchmark_group("shell time step");
     g.sample_size(10);
-    let matrices =
-        [(NewtonMatrix::Projected, "projected"), (NewtonMatrix::BendingGaussNewton, "bending-gauss-newton")];
+    let matrices = [(NewtonMatrix::Projected, "projected"), (NewtonMatrix::GaussNewton, "gauss-newton")];
     for (name, (matrix, matrix_name)) in
         ["stretch-x", "drape"].into_iter().flat_map(|n| matrices.map(|m| (n, m)))
     {

@@ -52,8 +52,8 @@ pub struct SimulateArgs {
     /// Implicit time steps per frame (overrides the scene).
     #[arg(long)]
     pub steps_per_frame: Option<u32>,
-    /// The Newton matrix after each step's first iteration (overrides the scene): the projected
-    /// element Hessians (Sec. 4.2) or Gauss-Newton in the bending strains (faster; same states).
+    /// The Newton matrix (overrides the scene): the projected element Hessians (Sec. 4.2) or
+    /// Gauss-Newton in the forms (faster, no 18 x 18 eigensolver; the same states).
     #[arg(long, value_enum)]
     pub newton_matrix: Option<NewtonMatrixArg>,
 }
@@ -63,15 +63,15 @@ pub struct SimulateArgs {
 pub enum NewtonMatrixArg {
     /// `projected`.
     Projected,
-    /// `bending-gauss-newton`.
-    BendingGaussNewton,
+    /// `gauss-newton`.
+    GaussNewton,
 }
 
 impl From<NewtonMatrixArg> for NewtonMatrix {
     fn from(arg: NewtonMatrixArg) -> Self {
         match arg {
             NewtonMatrixArg::Projected => NewtonMatrix::Projected,
-            NewtonMatrixArg::BendingGaussNewton => NewtonMatrix::BendingGaussNewton,
+            NewtonMatrixArg::GaussNewton => NewtonMatrix::GaussNewton,
         }
     }
 }

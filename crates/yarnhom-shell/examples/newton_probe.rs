@@ -1,7 +1,7 @@
 //! Newton convergence of the shell integrator on a built-in scene with a published material:
 //! per step the iterations, line-search halvings, final residual and wall time.
 //! `cargo run --release -p yarnhom-shell --example newton_probe -- SCENE MATERIAL N STEPS [TOLERANCE_M]
-//! [projected|bending-gauss-newton]`
+//! [projected|gauss-newton]`
 
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
@@ -24,7 +24,7 @@ fn main() {
     }
     if let Some(matrix) = args.get(6) {
         scene.newton_matrix = serde_json::from_value(serde_json::Value::String(matrix.clone()))
-            .expect("projected or bending-gauss-newton");
+            .expect("projected or gauss-newton");
     }
     let mut sim = prepare(&scene, ShellMaterial::spline(SplineMaterial::from(&spline))).expect("scene");
     for _ in 0..steps {

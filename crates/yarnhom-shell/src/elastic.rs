@@ -3,13 +3,13 @@
 //! Hessians (Sec. 4.2, after Teran et al. 2005), plus per-hinge bending (6.4) where the material
 //! has it.
 
-use nalgebra::{SMatrix, SVector, Vector3};
+use nalgebra::{Matrix2, SMatrix, SVector, Vector3};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::forms::{
-    RestTriangle, Stencil, first_form_of, first_form_with_derivatives, forms, forms_with_derivatives,
-    forms_with_gradient,
+    RestTriangle, Stencil, first_form_of, first_form_stress_hessian, first_form_with_derivatives, forms,
+    forms_with_derivatives, forms_with_gradient,
 };
 use crate::hinge::{HingeRest, anisotropic_stiffness, hinge_energy, hinge_energy_with_derivatives};
 use crate::material::ShellMaterial;
@@ -130,21 +130,24 @@ impl<const N: usize> SplitHessian<N> {
     }
 }
 
-/// The element matrices a Newton step takes, each made positive semidefinite per element.
+/// The element matrices a Newton step takes, each positive semidefinite.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NewtonMatrix {
-    /// The exact element Hessians (A.44), as Sec. 4.2 takes them.
+    /// The exact element Hessians (A.44) with their eigenvalues made absolute (Sec. 4.2 projects
+    /// them; Chen et al. 2024 flip rather than clamp): an 18 x 18 eigensolver for every element
+    /// that is not positive semidefinite.
     #[default]
     Projected,
-    /// (A.44) without the curvature forms' second derivatives weighted by the bending stress,
-    /// `Σ_k ∂Ψ/∂II_k ∇²II_k`: Gauss-Newton in the bending strains. That term holds every
-    /// negative eigenvalue of the element Hessians of a curling stockinette (the bending stress
-    /// is not zero on the flat cloth), so most elements need no eigensolver, and the six 18 x 18
-    /// Hessians of the forms are not computed. Newton takes as many iterations or somewhat more
-    /// (stock `drape`: 7.8 per step against 6.4), each cheaper. The gradient, and so the
-    /// solution, is unchanged.
-    BendingGaussNewton,
+    /// Gauss-Newton in the forms: (A.44) without the forms' second derivatives weighted by the
+    /// stress, `Σ_k ∂Ψ/∂z_k ∇²z_k`, except the first form's, whose stress is kept where it
+    /// stretches (`A (Jᵀ |∇²Ψ| J + (2 W S₊ Wᵀ) ⊗ Id₃)`, [`gauss_newton_matrix`]). Positive
+    /// semidefinite by construction, from a 6 x 6 and a 2 x 2 eigen-decomposition instead of an
+    /// 18 x 18 one, and the forms' six 18 x 18 Hessians are not computed. The dropped curvature
+    /// term holds every negative eigenvalue of the element Hessians of a curling stockinette (its
+    /// bending stress is not zero on the flat cloth). The gradient, and so the solution, is
+    /// unchanged.
+    GaussNewton,
 }
 
 /// Whether a symmetric matrix is positive semidefinite up to rounding: a Cholesky
@@ -174,9 +177,43 @@ macro_rules! split_hessian {
     };
 }
 
+split_hessian!(split_hessian_3, 3);
+split_hessian!(split_hessian_6, 6);
 split_hessian!(split_hessian_9, 9);
 split_hessian!(split_hessian_12, 12);
 split_hessian!(split_hessian_18, 18);
+
+/// The stress `s = ∂Ψ/∂I` as the symmetric `S = [[s_11, s_12/2], [s_12/2, s_22]]` with its
+/// compressive (negative) eigenvalues set to zero.
+fn tensile_stress(s: &[f64]) -> Matrix2<f64> {
+    let eigen = nalgebra::SymmetricEigen::new(Matrix2::new(s[0], 0.5 * s[1], 0.5 * s[1], s[2]));
+    let tension = eigen.eigenvalues.map(|l| l.max(0.0));
+    eigen.eigenvectors * Matrix2::from_diagonal(&tension) * eigen.eigenvectors.transpose()
+}
+
+/// The Gauss-Newton element matrix (per unit rest area) of an energy density `Ψ(z)` of `M` forms
+/// over `N` DOFs whose first 9 are the triangle's: `Jᵀ |∇²Ψ| J + (2 W S₊ Wᵀ) ⊗ Id₃`, where
+/// `J = ∂z/∂q`, `|∇²Ψ|` has the material Hessian's eigenvalues made absolute (`material` is
+/// `∇²Ψ` with its negative part) and `(2 W S₊ Wᵀ) ⊗ Id₃` is the first form's stress term
+/// `Σ_k ∂Ψ/∂I_k ∇²I_k` at the tensile part of the stress ([`first_form_stress_hessian`]).
+/// Positive semidefinite by construction.
+pub fn gauss_newton_matrix<const M: usize, const N: usize>(
+    rest: &RestTriangle,
+    jacobian: &SMatrix<f64, M, N>,
+    material: &SplitHessian<M>,
+    first_form_stress: &[f64],
+) -> SMatrix<f64, N, N> {
+    let mut h = jacobian.transpose() * material.absolute() * jacobian;
+    let k = first_form_stress_hessian(rest, &tensile_stress(first_form_stress));
+    for a in 0..3 {
+        for b in 0..3 {
+            for c in 0..3 {
+                h[(3 * a + c, 3 * b + c)] += k[(a, b)];
+            }
+        }
+    }
+    h
+}
 
 /// A cloth's elastic energy: mesh, rest data and material.
 #[derive(Debug, Clone)]
@@ -306,36 +343,53 @@ impl ElasticModel {
     /// and handed on in order (identical for any thread count).
     pub fn assemble(&self, x: &[Vector3<f64>], matrix: Option<NewtonMatrix>, out: &mut impl ElementSink) {
         let triangles = self.rest.len();
-        let hessian = matrix.is_some();
         if self.material.uses_second_form() {
             hand_on(triangles, 0, out, |t| (self.stencil_vertices(t), self.triangle_element(t, x, matrix)));
         } else {
             hand_on(triangles, 0, out, |t| {
-                (self.mesh.triangles[t].map(Some), self.membrane_element(t, x, hessian))
+                (self.mesh.triangles[t].map(Some), self.membrane_element(t, x, matrix))
             });
         }
         hand_on(self.hinges.len(), triangles, out, |k| {
             let vertices = self.mesh.hinges[k].vertices;
             let d = hinge_energy_with_derivatives(&self.hinges[k], &vertices.map(|v| x[v as usize]));
-            (vertices.map(Some), (d.energy, d.gradient, hessian.then(|| split_hessian_12(d.hessian))))
+            let h = matrix.map(|matrix| match matrix {
+                NewtonMatrix::GaussNewton => SplitHessian { matrix: d.gauss_newton, negative: None },
+                NewtonMatrix::Projected => split_hessian_12(d.hessian),
+            });
+            (vertices.map(Some), (d.energy, d.gradient, h))
         });
     }
 
     /// (4.8) for a membrane material (`Ψ(I)` only) over the triangle's 9 DOFs:
-    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂I_k ∇² I_k)`, with its negative part.
-    fn membrane_element(&self, t: usize, x: &[Vector3<f64>], hessian: bool) -> SplitElement<9> {
+    /// `∇²E = A (Jᵀ ∇²Ψ J + Σ_k ∂Ψ/∂I_k ∇² I_k)` with its negative part, or the
+    /// [`NewtonMatrix::GaussNewton`] matrix.
+    fn membrane_element(
+        &self,
+        t: usize,
+        x: &[Vector3<f64>],
+        matrix: Option<NewtonMatrix>,
+    ) -> SplitElement<9> {
         let rest = &self.rest[t];
         let forms = first_form_with_derivatives(rest, &self.mesh.triangles[t].map(|v| x[v as usize]));
         let jet = self.material.jet(forms.first, [0.0; 3]);
         let dpsi = jet.gradient.fixed_rows::<3>(0).into_owned();
         let area = rest.rest_area;
         let gradient = area * forms.gradient.transpose() * dpsi;
-        let h = hessian.then(|| {
-            let mut h = forms.gradient.transpose() * jet.hessian.fixed_view::<3, 3>(0, 0) * forms.gradient;
-            for (k, d2i) in forms.hessian.iter().enumerate() {
-                h += dpsi[k] * d2i;
+        let material = jet.hessian.fixed_view::<3, 3>(0, 0).into_owned();
+        let h = matrix.map(|matrix| match matrix {
+            NewtonMatrix::GaussNewton => {
+                let h =
+                    gauss_newton_matrix(rest, &forms.gradient, &split_hessian_3(material), dpsi.as_slice());
+                SplitHessian { matrix: area * h, negative: None }
             }
-            split_hessian_9(area * h)
+            NewtonMatrix::Projected => {
+                let mut h = forms.gradient.transpose() * material * forms.gradient;
+                for (k, d2i) in forms.hessian.iter().enumerate() {
+                    h += dpsi[k] * d2i;
+                }
+                split_hessian_9(area * h)
+            }
         });
         (area * jet.value, gradient, h)
     }
@@ -347,28 +401,36 @@ impl ElasticModel {
         x: &[Vector3<f64>],
         matrix: Option<NewtonMatrix>,
     ) -> SplitElement<18> {
-        let (e, g, h) = match matrix {
-            Some(NewtonMatrix::BendingGaussNewton) => self.triangle_element_gauss_newton(t, x),
-            _ => self.triangle_element_exact(t, x, matrix.is_some()),
-        };
-        (e, g, h.map(split_hessian_18))
+        match matrix {
+            Some(NewtonMatrix::GaussNewton) => {
+                let (e, g, h) = self.triangle_element_gauss_newton(t, x);
+                (e, g, Some(SplitHessian { matrix: h, negative: None }))
+            }
+            _ => {
+                let (e, g, h) = self.triangle_element_exact(t, x, matrix.is_some());
+                (e, g, h.map(split_hessian_18))
+            }
+        }
     }
 
-    /// (4.8) with (A.43) and the [`NewtonMatrix::BendingGaussNewton`] matrix
-    /// `A (Jᵀ ∇²Ψ J + Σ_{k ∈ I} ∂Ψ/∂I_k ∇² I_k)`, the first form's Hessians being those of the
-    /// triangle's 9 DOFs.
-    pub fn triangle_element_gauss_newton(&self, t: usize, x: &[Vector3<f64>]) -> Element<18> {
+    /// (4.8) with (A.43) and the [`NewtonMatrix::GaussNewton`] matrix
+    /// `A (Jᵀ |∇²Ψ| J + (2 W S₊ Wᵀ) ⊗ Id₃)` ([`gauss_newton_matrix`]).
+    pub fn triangle_element_gauss_newton(
+        &self,
+        t: usize,
+        x: &[Vector3<f64>],
+    ) -> (f64, SVector<f64, 18>, SMatrix<f64, 18, 18>) {
         let rest = &self.rest[t];
         let area = rest.rest_area;
         let forms = forms_with_gradient(rest, &self.stencil(t, x));
         let jet = self.material.jet(forms.first, forms.second);
-        let mut h = forms.gradient.transpose() * jet.hessian * forms.gradient;
-        let first = first_form_with_derivatives(rest, &self.mesh.triangles[t].map(|v| x[v as usize]));
-        let mut triangle = h.fixed_view_mut::<9, 9>(0, 0);
-        for (k, d2i) in first.hessian.iter().enumerate() {
-            triangle += jet.gradient[k] * d2i;
-        }
-        (area * jet.value, area * forms.gradient.transpose() * jet.gradient, Some(area * h))
+        let h = gauss_newton_matrix(
+            rest,
+            &forms.gradient,
+            &split_hessian_6(jet.hessian),
+            &jet.gradient.as_slice()[..3],
+        );
+        (area * jet.value, area * forms.gradient.transpose() * jet.gradient, area * h)
     }
 
     /// (4.8) with (A.43)-(A.44): `E = A Ψ(z(q))`, `∇E = A Jᵀ ∇Ψ`,
@@ -457,12 +519,24 @@ mod tests {
             mesh.material.iter().map(|m| Vector3::new(1.2 * m.x + 0.1 * m.y, 1.1 * m.y, 0.0)).collect();
         for t in 0..mesh.triangles.len() {
             let (e18, g18, h18) = model.triangle_element_exact(t, &x, true);
-            let (e9, g9, h9) = model.membrane_element(t, &x, true);
+            let (e9, g9, h9) = model.membrane_element(t, &x, Some(NewtonMatrix::Projected));
             let (h18, h9) = (h18.expect("asked for"), h9.expect("asked for").matrix);
             assert!((e18 - e9).abs() < 1e-15 * e18.abs().max(1.0));
             assert!((g18.fixed_rows::<9>(0) - g9).amax() < 1e-12 * g9.amax().max(1.0));
             assert!(g18.fixed_rows::<9>(9).amax() == 0.0);
             assert!((h18.fixed_view::<9, 9>(0, 0) - h9).amax() < 1e-9 * h9.amax().max(1.0), "triangle {t}");
+            // So is the Gauss-Newton matrix, the same construction on 3 forms instead of 6.
+            let (_, _, gn18) = model.triangle_element_gauss_newton(t, &x);
+            let (_, _, gn9) = model.membrane_element(t, &x, Some(NewtonMatrix::GaussNewton));
+            let gn9 = gn9.expect("asked for");
+            assert!(gn9.negative.is_none());
+            assert!(
+                (gn18.fixed_view::<9, 9>(0, 0) - gn9.matrix).amax() < 1e-9 * gn9.matrix.amax(),
+                "triangle {t}"
+            );
+            assert!(
+                gn18.fixed_view::<9, 9>(9, 0).amax() == 0.0 && gn18.fixed_view::<9, 9>(9, 9).amax() == 0.0
+            );
         }
         let mut a = Assembly::new(3 * x.len());
         model.assemble(&x, None, &mut a);
@@ -567,18 +641,40 @@ mod tests {
         }
     }
 
+    /// `m` with its eigenvalues made absolute, by a dense eigen-decomposition.
+    fn absolute_valued<const N: usize>(m: &SMatrix<f64, N, N>) -> nalgebra::DMatrix<f64> {
+        let eigen = nalgebra::DMatrix::from_fn(N, N, |i, j| m[(i, j)]).symmetric_eigen();
+        let abs = nalgebra::DMatrix::from_diagonal(&eigen.eigenvalues.map(f64::abs));
+        &eigen.eigenvectors * abs * eigen.eigenvectors.transpose()
+    }
+
     #[test]
-    fn the_bending_gauss_newton_matrix_drops_only_the_curvature_forms_second_derivatives() {
+    fn the_gauss_newton_matrix_is_psd_and_drops_only_the_stress_weighted_form_hessians() {
         let (model, x, t) = honeycomb_on_a_curved_mesh();
-        let (e, g, h) = model.triangle_element_exact(t, &x, true);
-        let (e_gn, g_gn, h_gn) = model.triangle_element_gauss_newton(t, &x);
-        assert_eq!((e, g), (e_gn, g_gn));
-        let (h, h_gn) = (h.expect("asked for"), h_gn.expect("asked for"));
-        let forms = forms_with_derivatives(&model.rest[t], &model.stencil(t, &x));
-        let jet = model.material.jet(forms.first, forms.second);
-        let dropped: SMatrix<f64, 18, 18> =
-            (3..6).map(|k| model.rest[t].rest_area * jet.gradient[k] * forms.hessian[k]).sum();
-        assert!(dropped.amax() > 1e-3 * h.amax(), "the curved cloth has a bending stress");
-        assert!((h - dropped - h_gn).amax() < 1e-10 * h.amax(), "{}", (h - dropped - h_gn).amax());
+        // As meshed (stretched along x), and compressed to 80% about the triangle.
+        let centre = x[model.mesh.triangles[t][0] as usize];
+        let compressed: Vec<_> = x.iter().map(|p| centre + 0.8 * (p - centre)).collect();
+        let mut clamped_stress = false;
+        for x in [x, compressed] {
+            let (e, g, _) = model.triangle_element_exact(t, &x, false);
+            let (e_gn, g_gn, h_gn) = model.triangle_element_gauss_newton(t, &x);
+            assert_eq!((e, g), (e_gn, g_gn));
+            let forms = forms_with_derivatives(&model.rest[t], &model.stencil(t, &x));
+            let jet = model.material.jet(forms.first, forms.second);
+            let j = nalgebra::DMatrix::from_fn(6, 18, |r, c| forms.gradient[(r, c)]);
+            let mut expected = j.transpose() * absolute_valued(&jet.hessian) * j;
+            // The first form's stress term at the stress's tensile part, in [11, 12, 22] entries.
+            let s = tensile_stress(&jet.gradient.as_slice()[..3]);
+            clamped_stress |= (s[(0, 0)] - jet.gradient[0]).abs() > 1e-9 * jet.gradient.amax();
+            for (k, weight) in [s[(0, 0)], 2.0 * s[(0, 1)], s[(1, 1)]].into_iter().enumerate() {
+                expected += weight * nalgebra::DMatrix::from_fn(18, 18, |r, c| forms.hessian[k][(r, c)]);
+            }
+            let expected = model.rest[t].rest_area * expected;
+            let error = (nalgebra::DMatrix::from_fn(18, 18, |r, c| h_gn[(r, c)]) - &expected).amax();
+            assert!(error < 1e-10 * expected.amax(), "{error}");
+            let lowest = h_gn.symmetric_eigenvalues().min();
+            assert!(lowest > -1e-12 * h_gn.amax(), "positive semidefinite: {lowest}");
+        }
+        assert!(clamped_stress, "compression leaves a stress to clamp");
     }
 }

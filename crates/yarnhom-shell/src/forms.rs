@@ -24,7 +24,7 @@
 //! paraboloid tests below).
 
 use crate::dihedral::{Hinge, Vec3, add_symmetric_block, angle_between_normals};
-use nalgebra::{ArrayStorage, Matrix2, Matrix3x2, SMatrix, Vector2};
+use nalgebra::{ArrayStorage, Matrix2, Matrix3, Matrix3x2, SMatrix, Vector2};
 
 /// Index pairs `(a, b)` of the stored entries `[11, 12, 22]` of a symmetric 2×2 form.
 const FORM_ENTRIES: [(usize, usize); 3] = [(0, 0), (0, 1), (1, 1)];
@@ -248,6 +248,16 @@ pub fn first_form_with_derivatives(rest: &RestTriangle, x: &[Vec3; 3]) -> FirstF
         }
     }
     out
+}
+
+/// `Σ_k s_k ∇²I_k = K ⊗ Id₃` over the triangle's 9 DOFs (from [`first_form_with_derivatives`]'s
+/// Hessians) for the stress `s = ∂Ψ/∂I` as the symmetric `S = [[s_11, s_12/2], [s_12/2, s_22]]`:
+/// `K = 2 W S Wᵀ`, `W` the 3 x 2 matrix of barycentric gradients, so `K` is positive
+/// semidefinite exactly when `S` is.
+pub fn first_form_stress_hessian(rest: &RestTriangle, stress: &Matrix2<f64>) -> Matrix3<f64> {
+    let w = rest.barycentric_gradients();
+    let w = Matrix3x2::from_rows(&w.map(|r| r.transpose()));
+    2.0 * w * stress * w.transpose()
 }
 
 /// The first form's rows of the gradient, and of the Hessians if given: the triangle's DOFs are

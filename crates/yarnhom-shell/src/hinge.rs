@@ -82,6 +82,8 @@ pub struct HingeEnergy {
     pub gradient: SVector<f64, 12>,
     /// Hessian.
     pub hessian: SMatrix<f64, 12, 12>,
+    /// Its Gauss-Newton part `2W ∇θ ⊗ ∇θ` (positive semidefinite; without `2W (θ - θ̄) ∇²θ`).
+    pub gauss_newton: SMatrix<f64, 12, 12>,
 }
 
 /// Curvature `κ = 3θ/H` of the hinge at positions `[e0, e1, a, b]`.
@@ -99,11 +101,12 @@ pub fn hinge_energy(rest: &HingeRest, hinge: &[Vec3; 4]) -> f64 {
 pub fn hinge_energy_with_derivatives(rest: &HingeRest, hinge: &[Vec3; 4]) -> HingeEnergy {
     let dihedral = signed_dihedral_angle_with_derivatives(hinge);
     let (excess, weight) = (dihedral.angle - rest.rest_angle, rest.angle_weight());
+    let gauss_newton = dihedral.gradient * dihedral.gradient.transpose() * (2.0 * weight);
     HingeEnergy {
         energy: weight * excess * excess,
         gradient: dihedral.gradient * (2.0 * weight * excess),
-        hessian: (dihedral.gradient * dihedral.gradient.transpose() + dihedral.hessian * excess)
-            * (2.0 * weight),
+        hessian: gauss_newton + dihedral.hessian * (2.0 * weight * excess),
+        gauss_newton,
     }
 }
 

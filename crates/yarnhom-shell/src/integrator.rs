@@ -8,10 +8,10 @@
 //! Hessians enter the Newton matrix with their eigenvalues replaced by their absolute values
 //! (Chen et al. 2024; from the same states of the published stretch and drape scenes, about a
 //! fifth fewer Newton iterations than with the eigenvalues clamped to zero), which changes the
-//! path to the minimum of `Φ`, not the minimum. [`NewtonMatrix::BendingGaussNewton`] takes, after
-//! a step's first iteration, Gauss-Newton element matrices in the bending strains instead,
-//! which need the eigensolver far less often (same `Φ`, same minimum). Rayleigh damping `D = α M + β K_n` (`K_n` the
-//! elastic Hessian clamped to PSD per element at the start of the step) enters as
+//! path to the minimum of `Φ`, not the minimum. [`NewtonMatrix::GaussNewton`] takes Gauss-Newton
+//! element matrices in the forms instead, positive semidefinite without the 18 x 18
+//! eigensolver (same `Φ`, same minimum). Rayleigh damping `D = α M + β K_n` (`K_n` the elastic
+//! Gauss-Newton matrix at the start of the step, positive semidefinite by construction) enters as
 //! `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
 //! Handle vertices follow their scripted positions and are removed from the unknowns. The
 //! Newton matrices are assembled straight into one sparsity pattern (the mesh's element
@@ -78,8 +78,8 @@ pub struct Dynamics {
     pub max_newton_iterations: u32,
     /// Newton stops when the largest position update is below this (m).
     pub tolerance_m: f64,
-    /// The element matrices of the Newton matrix after a step's first iteration (which takes
-    /// the projected Hessians, and with them the stiffness damping matrix).
+    /// The element matrices of the Newton matrix (the stiffness damping matrix always takes the
+    /// Gauss-Newton ones).
     pub newton_matrix: NewtonMatrix,
 }
 
@@ -341,18 +341,25 @@ impl Simulation {
         }
     }
 
-    /// Gradient and Newton matrix of `Φ`. On the step's first iteration the clamped elastic
-    /// Hessian is also kept, scaled by `β`, as the stiffness damping matrix `β K_n`, and that
-    /// iteration takes the projected Hessians whatever [`Dynamics::newton_matrix`] says, so that
-    /// `Φ` does not depend on it.
+    /// Gradient and Newton matrix of `Φ`. On the step's first iteration (with stiffness damping)
+    /// the elastic [`NewtonMatrix::GaussNewton`] matrix is also kept, scaled by `β`, as the
+    /// stiffness damping matrix `β K_n`, whatever [`Dynamics::newton_matrix`] says, so that `Φ`
+    /// does not depend on it.
     fn assemble(&self, x: &[Vector3<f64>], terms: &mut StepTerms, first: bool, a: &mut NewtonAssembly) {
         let h = self.dynamics.dt_s;
         let beta = self.dynamics.stiffness_damping;
-        a.clear(first && beta > 0.0);
-        let matrix = if first { NewtonMatrix::Projected } else { self.dynamics.newton_matrix };
-        self.model.assemble(x, Some(matrix), a);
-        if let Some(clamped) = a.clamped.take() {
-            terms.stiffness_damping = clamped.iter().map(|v| beta * v).collect();
+        let matrix = self.dynamics.newton_matrix;
+        if first && beta > 0.0 {
+            a.clear();
+            self.model.assemble(x, Some(NewtonMatrix::GaussNewton), a);
+            terms.stiffness_damping = a.matrix.iter().map(|v| beta * v).collect();
+            if matrix != NewtonMatrix::GaussNewton {
+                a.clear();
+                self.model.assemble(x, Some(matrix), a);
+            }
+        } else {
+            a.clear();
+            self.model.assemble(x, Some(matrix), a);
         }
         let g = Vector3::from(self.dynamics.gravity);
         let alpha = self.dynamics.mass_damping;

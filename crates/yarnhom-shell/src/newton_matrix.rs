@@ -160,8 +160,7 @@ impl Cholesky {
 /// Energy, gradient and Newton matrix of a time step assembled on a [`HessianPattern`]: element
 /// Hessians enter with their eigenvalues replaced by their absolute values (a direction of
 /// negative curvature keeps its magnitude, where the clamp to zero leaves it flat; Newton takes
-/// fewer iterations); on request the clamped elastic Hessian is also kept on its own (the
-/// stiffness-damping matrix).
+/// fewer iterations).
 pub(crate) struct NewtonAssembly<'p> {
     pattern: &'p HessianPattern,
     /// Energy (J).
@@ -170,8 +169,6 @@ pub(crate) struct NewtonAssembly<'p> {
     pub gradient: Vec<f64>,
     /// Lower-triangle values of the Newton matrix on the pattern (N/m).
     pub matrix: Vec<f64>,
-    /// The clamped elastic Hessian on the pattern, while recorded.
-    pub clamped: Option<Vec<f64>>,
 }
 
 impl<'p> NewtonAssembly<'p> {
@@ -182,16 +179,14 @@ impl<'p> NewtonAssembly<'p> {
             energy: 0.0,
             gradient: vec![0.0; pattern.structure.ncols()],
             matrix: vec![0.0; pattern.len()],
-            clamped: None,
         }
     }
 
-    /// Empty it, keeping its memory; `record_clamped` asks for the clamped elastic Hessian.
-    pub(crate) fn clear(&mut self, record_clamped: bool) {
+    /// Empty it, keeping its memory.
+    pub(crate) fn clear(&mut self) {
         self.energy = 0.0;
         self.gradient.fill(0.0);
         self.matrix.fill(0.0);
-        self.clamped = record_clamped.then(|| vec![0.0; self.pattern.len()]);
     }
 }
 
@@ -212,15 +207,12 @@ impl ElementSink for NewtonAssembly<'_> {
             }
         }
         let Some(h) = hessian else { return };
-        let (absolute, clamped) = (h.absolute(), self.clamped.as_ref().map(|_| h.clamped()));
+        let absolute = h.absolute();
         let mut slots = self.pattern.element_slots[self.pattern.element_starts[index]..].iter();
         for i in 0..N {
             for (j, &slot) in (0..=i).zip(&mut slots) {
                 if slot != ABSENT {
                     self.matrix[slot as usize] += absolute[(i, j)];
-                    if let (Some(all), Some(element)) = (&mut self.clamped, &clamped) {
-                        all[slot as usize] += element[(i, j)];
-                    }
                 }
             }
         }
@@ -237,7 +229,7 @@ mod tests {
         let elements = vec![vec![Some(0), Some(1)], vec![Some(1), Some(2)], vec![Some(2), None]];
         let pattern = HessianPattern::new(3, &elements);
         let mut a = NewtonAssembly::new(&pattern);
-        a.clear(true);
+        a.clear();
         let h = SplitHessian::<6> {
             matrix: nalgebra::SMatrix::from_fn(|i, j| (1 + i + j) as f64),
             negative: None,
@@ -254,7 +246,6 @@ mod tests {
         let expected = &dense * nalgebra::DVector::from_column_slice(&v);
         let product = pattern.symmetric_product(&a.matrix, &v);
         assert!(product.iter().zip(expected.iter()).all(|(p, e)| (p - e).abs() < 1e-12));
-        assert_eq!(a.clamped.as_deref(), Some(a.matrix.as_slice()));
         assert_eq!(a.energy, 3.0);
         assert_eq!(a.gradient, vec![1.0, 1.0, 1.0, 2.0, 2.0, 2.0, 1.0, 1.0, 1.0]);
         assert_eq!(pattern.vertex_block_slot(1, 2, 0), pattern.slot(5, 3));
@@ -300,19 +291,19 @@ mod tests {
         for material in materials {
             let model = ElasticModel::new(mesh.clone(), material);
             let pattern = HessianPattern::new(x.len(), &model.element_vertices());
+            // Gauss-Newton element matrices have no negative part, so the triplets' clamped
+            // matrices and the pattern's absolute-valued ones are the same.
             let (mut triplets, mut a) = (Assembly::new(3 * x.len()), NewtonAssembly::new(&pattern));
-            model.assemble(&x, Some(NewtonMatrix::Projected), &mut triplets);
-            a.clear(true);
-            model.assemble(&x, Some(NewtonMatrix::Projected), &mut a);
+            model.assemble(&x, Some(NewtonMatrix::GaussNewton), &mut triplets);
+            a.clear();
+            model.assemble(&x, Some(NewtonMatrix::GaussNewton), &mut a);
             assert!(triplets.triplets.iter().any(|t| t.2 != 0.0));
             let expected = dense_from_triplets(3 * x.len(), &triplets.triplets);
-            // The recorded clamped Hessian is the triplets' matrix.
-            let clamped = a.clamped.as_ref().expect("recorded");
             let mut entries = Vec::new();
             for col in 0..3 * x.len() {
                 let range = pattern.structure.col_range(col);
                 let rows = &pattern.structure.row_idx()[range.clone()];
-                entries.extend(rows.iter().zip(&clamped[range]).map(|(&r, &v)| (r, col, v)));
+                entries.extend(rows.iter().zip(&a.matrix[range]).map(|(&r, &v)| (r, col, v)));
             }
             let actual = dense_from_triplets(3 * x.len(), &entries);
             assert!((actual - &expected).amax() < 1e-12 * expected.amax());

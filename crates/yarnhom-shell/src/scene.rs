@@ -50,7 +50,7 @@ pub struct Scene {
     /// Newton tolerance on the position update (m).
     pub tolerance_m: f64,
     /// The element matrices of the Newton matrix (`projected`, the default, or
-    /// `bending-gauss-newton`).
+    /// `gauss-newton`).
     #[serde(default)]
     pub newton_matrix: NewtonMatrix,
 }

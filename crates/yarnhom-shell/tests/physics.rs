@@ -161,13 +161,15 @@ fn a_patch_draped_on_a_sphere_comes_to_rest_without_penetrating_it() {
 
 #[test]
 fn both_newton_matrices_reach_the_same_states() {
-    // The Newton matrix changes the path to each step's minimum of `Φ`, not `Φ` (the first
-    // iteration of a step, which also sets the stiffness damping, is projected either way): the
-    // curling stockinette, stretched and hanging, takes the same states with the projected
-    // Hessians and with Gauss-Newton in the bending strains, to the Newton tolerance (1e-6 m).
+    // The Newton matrix changes the path to each step's minimum of `Φ`, not `Φ` (the stiffness
+    // damping takes the Gauss-Newton matrix either way): the curling stockinette, stretched and
+    // hanging, takes the same states with the projected Hessians and with Gauss-Newton in the
+    // forms, to the Newton tolerance (1e-6 m).
     let run = |matrix: NewtonMatrix| {
         let mut s = scene("stretch-x", 11, 2);
         s.newton_matrix = matrix;
+        s.tolerance_m = 1e-9;
+        s.max_newton_iterations = 200;
         let mut sim = prepare(&s, published("stock1")).expect("scene");
         let mut iterations = 0;
         for _ in 0..12 {
@@ -178,9 +180,12 @@ fn both_newton_matrices_reach_the_same_states() {
         (sim.positions, iterations)
     };
     let (projected, projected_iterations) = run(NewtonMatrix::Projected);
-    let (gauss_newton, gauss_newton_iterations) = run(NewtonMatrix::BendingGaussNewton);
+    let (gauss_newton, gauss_newton_iterations) = run(NewtonMatrix::GaussNewton);
     let largest = projected.iter().zip(&gauss_newton).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
-    assert!(largest < 1e-6, "largest difference {largest} m");
+    eprintln!(
+        "largest difference {largest} m, iterations {projected_iterations} and {gauss_newton_iterations}"
+    );
+    assert!(largest < 1e-8, "largest difference {largest} m");
     // And neither needs many more iterations than the other.
     assert!(
         gauss_newton_iterations <= 2 * projected_iterations,
