@@ -88,6 +88,28 @@ pub enum BendingAxis {
     Y,
 }
 
+impl BendingAxis {
+    /// `+1` for x-bending, `-1` for y-bending: the sign of `B` in `E ± B D`.
+    fn sign(self) -> f64 {
+        match self {
+            BendingAxis::X => 1.0,
+            BendingAxis::Y => -1.0,
+        }
+    }
+}
+
+/// `E = (φ+ + φ-)/2` and `D = (φ+ - φ-)/2S` of a term's values at `λ1` and `λ2`.
+fn blend_parts(split: &CurvatureSplit, first: f64, second: f64) -> (f64, f64) {
+    (0.5 * (first + second), (first - second) / (2.0 * split.half_gap))
+}
+
+/// The value of the blend (A.41) of a term valued `first` at `λ1` and `second` at `λ2`: the
+/// same as [`blend`]'s, to the last bit.
+pub fn blend_value(split: &CurvatureSplit, axis: BendingAxis, first: f64, second: f64) -> f64 {
+    let (e, d) = blend_parts(split, first, second);
+    e + axis.sign() * split.half_difference * d
+}
+
 /// The blend (A.41) of a term evaluated at `λ1` (`at_first`) and `λ2` (`at_second`), with its
 /// gradient and Hessian in `(x, II11, II12, II22)`. `scale` is the term's curvature scale (its
 /// normalization), which sets what counts as a small gap.
@@ -100,13 +122,9 @@ pub fn blend(
 ) -> (f64, Vector4<f64>, Matrix4<f64>) {
     let (p, q) = (at_first, at_second);
     let u = split.half_gap;
-    let sign = match axis {
-        BendingAxis::X => 1.0,
-        BendingAxis::Y => -1.0,
-    };
+    let sign = axis.sign();
     let sb = sign * split.half_difference;
     // E = (φ+ + φ-)/2 and its derivatives in (x, m, t); ∂/∂t = ∂/∂S / 2S.
-    let e = 0.5 * (p.value + q.value);
     let (e_x, e_m) = (0.5 * (p.x + q.x), 0.5 * (p.l + q.l));
     let (e_xx, e_xm, e_mm) = (0.5 * (p.xx + q.xx), 0.5 * (p.xl + q.xl), 0.5 * (p.ll + q.ll));
     let e_t = (p.l - q.l) / (4.0 * u);
@@ -114,7 +132,7 @@ pub fn blend(
     let e_mt = (p.ll - q.ll) / (4.0 * u);
     let e_tt = (u * (p.ll + q.ll) - (p.l - q.l)) / (8.0 * u * u * u);
     // D = (φ+ - φ-)/2S and its derivatives.
-    let d = (p.value - q.value) / (2.0 * u);
+    let (e, d) = blend_parts(split, p.value, q.value);
     let (d_x, d_m) = ((p.x - q.x) / (2.0 * u), (p.l - q.l) / (2.0 * u));
     let (d_xx, d_xm, d_mm) =
         ((p.xx - q.xx) / (2.0 * u), (p.xl - q.xl) / (2.0 * u), (p.ll - q.ll) / (2.0 * u));

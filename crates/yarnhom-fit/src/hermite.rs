@@ -30,46 +30,70 @@ pub struct Jet2 {
     pub d2: [f64; 3],
 }
 
-/// The cubic Hermite basis on one interval and its derivatives, already scaled to the knot
-/// coordinate: `[value at left, value at right, slope at left, slope at right]` weights.
+/// Where `x` falls among a spline's knots: inside the interval `knots[i]..knots[i + 1]` at
+/// `s = (x - knots[i]) / h`, or past an end knot by `d` (the linear continuation).
 #[derive(Debug, Clone, Copy)]
-struct Basis {
-    w: [[f64; 4]; 3],
+enum Place {
+    Below(f64),
+    Inside { s: f64, h: f64 },
+    Above(f64),
 }
 
-/// Where `x` falls among `knots`: the interval index `i` (`knots[i]..knots[i + 1]`) and the
-/// Hermite basis there; outside the knots, the linear continuation of the end knot.
-fn locate(knots: &[f64], x: f64) -> (usize, Basis) {
+/// The interval index `i` (`knots[i]..knots[i + 1]`, the first or last past the ends) of `x`.
+fn locate(knots: &[f64], x: f64) -> (usize, Place) {
     let last = knots.len() - 1;
     let i = knots.partition_point(|&t| t <= x).clamp(1, last) - 1;
-    let h = knots[i + 1] - knots[i];
-    let s = (x - knots[i]) / h;
-    let basis = if x < knots[0] {
-        // linear from the first knot: p0 + (x - t0) m0
-        Basis { w: [[1.0, 0.0, x - knots[0], 0.0], [0.0, 0.0, 1.0, 0.0], [0.0; 4]] }
+    let place = if x < knots[0] {
+        Place::Below(x - knots[0])
     } else if x > knots[last] {
-        Basis { w: [[0.0, 1.0, 0.0, x - knots[last]], [0.0, 0.0, 0.0, 1.0], [0.0; 4]] }
+        Place::Above(x - knots[last])
     } else {
-        let (s2, s3) = (s * s, s * s * s);
-        Basis {
-            w: [
-                [2.0 * s3 - 3.0 * s2 + 1.0, -2.0 * s3 + 3.0 * s2, h * (s3 - 2.0 * s2 + s), h * (s3 - s2)],
-                [
-                    (6.0 * s2 - 6.0 * s) / h,
-                    (-6.0 * s2 + 6.0 * s) / h,
-                    3.0 * s2 - 4.0 * s + 1.0,
-                    3.0 * s2 - 2.0 * s,
-                ],
-                [
-                    (12.0 * s - 6.0) / (h * h),
-                    (-12.0 * s + 6.0) / (h * h),
-                    (6.0 * s - 4.0) / h,
-                    (6.0 * s - 2.0) / h,
-                ],
-            ],
-        }
+        let h = knots[i + 1] - knots[i];
+        Place::Inside { s: (x - knots[i]) / h, h }
     };
-    (i, basis)
+    (i, place)
+}
+
+impl Place {
+    /// The cubic Hermite weights of `[value at left, value at right, slope at left, slope at
+    /// right]` for the value; past an end knot, its value plus slope times distance.
+    fn value_weights(self) -> [f64; 4] {
+        match self {
+            Place::Below(d) => [1.0, 0.0, d, 0.0],
+            Place::Above(d) => [0.0, 1.0, 0.0, d],
+            Place::Inside { s, h } => {
+                let (s2, s3) = (s * s, s * s * s);
+                [2.0 * s3 - 3.0 * s2 + 1.0, -2.0 * s3 + 3.0 * s2, h * (s3 - 2.0 * s2 + s), h * (s3 - s2)]
+            }
+        }
+    }
+
+    /// The weights of the value, first and second derivative (in the knot coordinate).
+    fn basis(self) -> [[f64; 4]; 3] {
+        let value = self.value_weights();
+        match self {
+            Place::Below(_) => [value, [0.0, 0.0, 1.0, 0.0], [0.0; 4]],
+            Place::Above(_) => [value, [0.0, 0.0, 0.0, 1.0], [0.0; 4]],
+            Place::Inside { s, h } => {
+                let s2 = s * s;
+                [
+                    value,
+                    [
+                        (6.0 * s2 - 6.0 * s) / h,
+                        (-6.0 * s2 + 6.0 * s) / h,
+                        3.0 * s2 - 4.0 * s + 1.0,
+                        3.0 * s2 - 2.0 * s,
+                    ],
+                    [
+                        (12.0 * s - 6.0) / (h * h),
+                        (-12.0 * s + 6.0) / (h * h),
+                        (6.0 * s - 4.0) / h,
+                        (6.0 * s - 2.0) / h,
+                    ],
+                ]
+            }
+        }
+    }
 }
 
 /// A cubic Hermite spline with linear extrapolation.
@@ -86,16 +110,27 @@ pub struct Cubic {
 impl Cubic {
     /// Value and derivatives at `x`.
     pub fn jet(&self, x: f64) -> Jet1 {
-        let (i, b) = locate(&self.knots, x);
-        let coefficients = [self.values[i], self.values[i + 1], self.slopes[i], self.slopes[i + 1]];
-        let dot = |w: &[f64; 4]| w.iter().zip(&coefficients).map(|(w, c)| w * c).sum::<f64>();
-        Jet1 { value: dot(&b.w[0]), d1: dot(&b.w[1]), d2: dot(&b.w[2]) }
+        let (i, place) = locate(&self.knots, x);
+        let [w0, w1, w2] = place.basis();
+        let c = self.coefficients(i);
+        Jet1 { value: dot4(&w0, &c), d1: dot4(&w1, &c), d2: dot4(&w2, &c) }
     }
 
-    /// The value at `x`.
+    /// The value at `x` (the same as [`Cubic::jet`]'s, to the last bit).
     pub fn value(&self, x: f64) -> f64 {
-        self.jet(x).value
+        let (i, place) = locate(&self.knots, x);
+        dot4(&place.value_weights(), &self.coefficients(i))
     }
+
+    /// Interval `i`'s Hermite coefficients: values and slopes at its ends.
+    fn coefficients(&self, i: usize) -> [f64; 4] {
+        [self.values[i], self.values[i + 1], self.slopes[i], self.slopes[i + 1]]
+    }
+}
+
+/// `Σ w_k c_k`.
+fn dot4(w: &[f64; 4], c: &[f64; 4]) -> f64 {
+    w.iter().zip(c).map(|(w, c)| w * c).sum()
 }
 
 impl From<&yarnhom_artifacts::CubicTerm> for Cubic {
@@ -139,41 +174,50 @@ impl From<&yarnhom_artifacts::BicubicTerm> for Bicubic {
 impl Bicubic {
     /// Value, gradient and Hessian at `(u, v)`.
     pub fn jet(&self, u: f64, v: f64) -> Jet2 {
-        let (i, bu) = locate(&self.u_knots, u);
-        let (j, bv) = locate(&self.v_knots, v);
+        let (i, pu) = locate(&self.u_knots, u);
+        let (j, pv) = locate(&self.v_knots, v);
+        let c = self.coefficients(i, j);
+        let [u0, u1, u2] = pu.basis();
+        let [v0, v1, v2] = pv.basis();
+        Jet2 {
+            value: contract(&c, &u0, &v0),
+            d1: [contract(&c, &u1, &v0), contract(&c, &u0, &v1)],
+            d2: [contract(&c, &u2, &v0), contract(&c, &u1, &v1), contract(&c, &u0, &v2)],
+        }
+    }
+
+    /// The value at `(u, v)` (the same as [`Bicubic::jet`]'s, to the last bit).
+    pub fn value(&self, u: f64, v: f64) -> f64 {
+        let (i, pu) = locate(&self.u_knots, u);
+        let (j, pv) = locate(&self.v_knots, v);
+        contract(&self.coefficients(i, j), &pu.value_weights(), &pv.value_weights())
+    }
+
+    /// Cell `(i, j)`'s coefficients `c[a][b]`: `a` over the u-basis (value left/right, slope
+    /// left/right), `b` over v.
+    fn coefficients(&self, i: usize, j: usize) -> [[f64; 4]; 4] {
         let nu = self.u_knots.len();
-        // Coefficients c[a][b]: a over the u-basis (value left/right, slope left/right), b over v.
-        let node = |di: usize, dj: usize| (j + dj) * nu + i + di;
         let mut c = [[0.0; 4]; 4];
         for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-            let k = node(di, dj);
+            let k = (j + dj) * nu + i + di;
             c[di][dj] = self.values[k];
             c[2 + di][dj] = self.du[k];
             c[di][2 + dj] = self.dv[k];
             c[2 + di][2 + dj] = self.duv[k];
         }
-        let contract = |wu: &[f64; 4], wv: &[f64; 4]| {
-            let mut sum = 0.0;
-            for a in 0..4 {
-                for b in 0..4 {
-                    sum += wu[a] * c[a][b] * wv[b];
-                }
-            }
-            sum
-        };
-        let [u0, u1, u2] = &bu.w;
-        let [v0, v1, v2] = &bv.w;
-        Jet2 {
-            value: contract(u0, v0),
-            d1: [contract(u1, v0), contract(u0, v1)],
-            d2: [contract(u2, v0), contract(u1, v1), contract(u0, v2)],
+        c
+    }
+}
+
+/// `Σ_ab wu_a c_ab wv_b`.
+fn contract(c: &[[f64; 4]; 4], wu: &[f64; 4], wv: &[f64; 4]) -> f64 {
+    let mut sum = 0.0;
+    for a in 0..4 {
+        for b in 0..4 {
+            sum += wu[a] * c[a][b] * wv[b];
         }
     }
-
-    /// The value at `(u, v)`.
-    pub fn value(&self, u: f64, v: f64) -> f64 {
-        self.jet(u, v).value
-    }
+    sum
 }
 
 #[cfg(test)]

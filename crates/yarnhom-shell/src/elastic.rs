@@ -137,7 +137,6 @@ pub enum NewtonMatrix {
     /// The exact element Hessians (A.44) with their eigenvalues made absolute (Sec. 4.2 projects
     /// them; Chen et al. 2024 flip rather than clamp): an 18 x 18 eigensolver for every element
     /// that is not positive semidefinite.
-    #[default]
     Projected,
     /// Gauss-Newton in the forms: (A.44) without the forms' second derivatives weighted by the
     /// stress, `Σ_k ∂Ψ/∂z_k ∇²z_k`, except the first form's, whose stress is kept where it
@@ -146,7 +145,9 @@ pub enum NewtonMatrix {
     /// 18 x 18 one, and the forms' six 18 x 18 Hessians are not computed. The dropped curvature
     /// term holds every negative eigenvalue of the element Hessians of a curling stockinette (its
     /// bending stress is not zero on the flat cloth). The gradient, and so the solution, is
-    /// unchanged.
+    /// unchanged. The default: per time step 2.4 times faster than `Projected` on the published
+    /// stretch and drape scenes.
+    #[default]
     GaussNewton,
 }
 

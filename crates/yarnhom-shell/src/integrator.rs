@@ -249,7 +249,9 @@ impl Simulation {
                 .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
             factor.solve_in_place(&mut dx);
-            let phi0 = phi.unwrap_or_else(|| self.potential(&x, &terms));
+            // The assembly's energy is `E(x)` (the first iteration's; later ones reuse the line
+            // search's `Φ`).
+            let phi0 = phi.unwrap_or_else(|| a.energy + self.potential_besides_elastic(&x, &terms));
             let slope = dot(&a.gradient, &dx);
             let (alpha, halvings, accepted) =
                 backtrack(&x, &dx, phi0, slope, |trial| self.potential(trial, &terms));
@@ -311,9 +313,14 @@ impl Simulation {
 
     /// `Φ(x)` without the damping term's constant parts.
     fn potential(&self, x: &[Vector3<f64>], terms: &StepTerms) -> f64 {
+        self.model.energy(x) + self.potential_besides_elastic(x, terms)
+    }
+
+    /// The terms of `Φ(x)` other than the elastic energy `E(x)`.
+    fn potential_besides_elastic(&self, x: &[Vector3<f64>], terms: &StepTerms) -> f64 {
         let h = self.dynamics.dt_s;
         let g = Vector3::from(self.dynamics.gravity);
-        let (alpha, mut phi) = (self.dynamics.mass_damping, self.model.energy(x));
+        let (alpha, mut phi) = (self.dynamics.mass_damping, 0.0);
         for (i, p) in x.iter().enumerate() {
             let m = self.masses[i];
             phi += m * (p - terms.predicted[i]).norm_squared() / (2.0 * h * h) - m * g.dot(p);

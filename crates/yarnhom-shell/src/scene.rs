@@ -49,8 +49,8 @@ pub struct Scene {
     pub max_newton_iterations: u32,
     /// Newton tolerance on the position update (m).
     pub tolerance_m: f64,
-    /// The element matrices of the Newton matrix (`projected`, the default, or
-    /// `gauss-newton`).
+    /// The element matrices of the Newton matrix (`gauss-newton`, the default, or
+    /// `projected`).
     #[serde(default)]
     pub newton_matrix: NewtonMatrix,
 }
@@ -136,7 +136,7 @@ impl Scene {
             },
             max_newton_iterations: 30,
             tolerance_m: 1e-4,
-            newton_matrix: NewtonMatrix::Projected,
+            newton_matrix: NewtonMatrix::default(),
         };
         let bar = |side: u8, motion: usize| HandleSpec::Bar {
             side,
