@@ -38,4 +38,8 @@ fn main() {
             sim.time_s, s.newton_iterations, s.line_search_steps, s.residual_n, s.converged, s.wall_time_s
         );
     }
+    if let Ok(path) = std::env::var("PROBE_DUMP") {
+        let text: String = sim.positions.iter().map(|p| format!("{} {} {}\n", p.x, p.y, p.z)).collect();
+        std::fs::write(path, text).expect("dump");
+    }
 }

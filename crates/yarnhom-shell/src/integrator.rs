@@ -28,6 +28,10 @@ use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;
 use crate::newton_matrix::{HessianPattern, NewtonAssembly};
 
+/// Newton starts at the inertial prediction when it moves no vertex by more than this many
+/// Newton tolerances ([`Simulation::step`]).
+pub const INERTIAL_START_TOLERANCES: f64 = 10.0;
+
 /// A piecewise linear translation over time (keyframes `(time_s, translation_m)`), constant
 /// before the first and after the last key.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -225,9 +229,8 @@ impl Simulation {
         let next_time = self.time_s + h;
         let start = self.positions.clone();
         let predicted: Vec<_> = start.iter().zip(&self.velocities).map(|(x, v)| x + h * v).collect();
-        let mut x = start.clone();
-        self.move_handles(&mut x, next_time);
         let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new() };
+        let mut x = self.newton_start(&terms, next_time);
         let mut stats = StepStats {
             newton_iterations: 0,
             residual_n: 0.0,
@@ -275,6 +278,22 @@ impl Simulation {
         self.finish_step(x, &terms.start, next_time);
         stats.wall_time_s = started.elapsed().as_secs_f64();
         Ok(stats)
+    }
+
+    /// Where Newton starts, handles at their positions at `time_s`: at the inertial prediction
+    /// `x̂ = x_n + h v_n` when no vertex's `h |v_i|` exceeds [`INERTIAL_START_TOLERANCES`]
+    /// Newton tolerances, else at `x_n`. From `x̂` the first update is of the order of `h² a`,
+    /// from `x_n` at least `h v`: with short steps `x̂` is far closer (at the published
+    /// Δt = 0.209 ms, one Newton iteration per step instead of two), while with long ones it
+    /// overshoots a swinging cloth (at 4.2 ms from `x̂`: 5.1 iterations per step against 4.9 in
+    /// `stretch-x`, 6.0 against 4.6 in `drape`).
+    fn newton_start(&self, terms: &StepTerms, time_s: f64) -> Vec<Vector3<f64>> {
+        let h = self.dynamics.dt_s;
+        let fastest = self.velocities.iter().fold(0.0_f64, |m, v| m.max(v.amax()));
+        let short = h * fastest <= INERTIAL_START_TOLERANCES * self.dynamics.tolerance_m;
+        let mut x = if short { terms.predicted.clone() } else { terms.start.clone() };
+        self.move_handles(&mut x, time_s);
+        x
     }
 
     /// Handle vertices at their scripted positions at `time_s`.
