@@ -54,8 +54,16 @@ fn bench_kernels(c: &mut Criterion) {
     g.bench_function("spline element: forms, material jet, A.5 composition", |b| {
         b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), true))
     });
-    g.bench_function("spline element, Gauss-Newton bending matrix (no forms' Hessians)", |b| {
+    g.bench_function("spline element, Gauss-Newton matrix (no forms' Hessians, PSD by construction)", |b| {
         b.iter(|| model.triangle_element_gauss_newton(t, std::hint::black_box(&x)))
+    });
+    let material = SplineMaterial::from(&spline);
+    let (first, second) = model.triangle_forms(t, &x);
+    g.bench_function("spline material jet: energy density with gradient and Hessian in the forms", |b| {
+        b.iter(|| material.jet(std::hint::black_box(first), second))
+    });
+    g.bench_function("spline material energy density alone (line searches)", |b| {
+        b.iter(|| material.energy_density(std::hint::black_box(first), second))
     });
     g.bench_function("spline element, energy and gradient only", |b| {
         b.iter(|| model.triangle_element_exact(t, std::hint::black_box(&x), false))

@@ -26,7 +26,7 @@ use nalgebra::{Matrix3, Vector3};
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
 use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;
-use crate::newton_matrix::{HessianPattern, NewtonAssembly};
+use crate::newton_matrix::{CholeskyWorkspace, HessianPattern, NewtonAssembly};
 
 /// Newton starts at the inertial prediction when it moves no vertex by more than this many
 /// Newton tolerances ([`Simulation::step`]).
@@ -140,6 +140,8 @@ pub struct Simulation {
     pattern: HessianPattern,
     /// The slots of the Newton matrix in the rows and columns of the fixed DOFs.
     pinned: Vec<usize>,
+    /// The Cholesky factor's memory, kept from step to step.
+    cholesky: Option<CholeskyWorkspace>,
 }
 
 /// The parts of `Φ` that do not change within a step.
@@ -185,6 +187,7 @@ impl Simulation {
             dynamics,
             pattern,
             pinned,
+            cholesky: None,
             model,
         }
     }
@@ -240,15 +243,16 @@ impl Simulation {
         };
         // One buffer for every iteration's assembly, so its memory is allocated once per step.
         let mut a = NewtonAssembly::new(&self.pattern);
+        let mut workspace = self.cholesky.take().unwrap_or_else(|| self.pattern.workspace());
         // Φ at the current iterate, when the last line search computed it.
         let mut phi: Option<f64> = None;
         for iteration in 0..self.dynamics.max_newton_iterations {
             self.assemble(&x, &mut terms, iteration == 0, &mut a);
             self.pin(&mut a);
             stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
-            let factor = self
+            let mut factor = self
                 .pattern
-                .factor(&a.matrix)
+                .factor(&a.matrix, &mut workspace)
                 .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
             factor.solve_in_place(&mut dx);
@@ -275,6 +279,7 @@ impl Simulation {
                 break;
             }
         }
+        self.cholesky = Some(workspace);
         self.finish_step(x, &terms.start, next_time);
         stats.wall_time_s = started.elapsed().as_secs_f64();
         Ok(stats)

@@ -4,10 +4,10 @@
 //! straight into the pattern's values through slots computed once, and the Cholesky
 //! factorization (faer) reuses the pattern's symbolic analysis.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{MatMut, Side};
+use faer::{Conj, MatMut, Side, get_global_parallelism};
 
 use crate::elastic::{ElementSink, SplitHessian};
 
@@ -22,7 +22,7 @@ pub(crate) struct NotPositiveDefinite;
 /// slots of its elements' entries.
 pub(crate) struct HessianPattern {
     structure: SymbolicSparseColMat<usize>,
-    symbolic: SymbolicLlt<usize>,
+    symbolic: SymbolicCholesky<usize>,
     /// Per element, the slot of each entry `(i, j)`, `j <= i`, of its local lower triangle in
     /// row-major order ([`ABSENT`] where a vertex is absent); element `e`'s slots start at
     /// `element_starts[e]`.
@@ -58,8 +58,13 @@ impl HessianPattern {
         }
         let n = 3 * vertices;
         let structure = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
-        let symbolic = SymbolicLlt::try_new(structure.as_ref(), Side::Lower)
-            .unwrap_or_else(|e| unreachable!("a valid pattern has a symbolic Cholesky factor: {e:?}"));
+        let symbolic = factorize_symbolic_cholesky(
+            structure.as_ref(),
+            Side::Lower,
+            Default::default(),
+            Default::default(),
+        )
+        .unwrap_or_else(|e| unreachable!("a valid pattern has a symbolic Cholesky factor: {e:?}"));
         let mut pattern = Self { structure, symbolic, element_slots: Vec::new(), element_starts: Vec::new() };
         for element in elements {
             pattern.element_starts.push(pattern.element_slots.len());
@@ -137,23 +142,67 @@ impl HessianPattern {
         out
     }
 
-    /// The Cholesky factor of the symmetric matrix with lower-triangle `values`.
-    pub(crate) fn factor(&self, values: &[f64]) -> Result<Cholesky, NotPositiveDefinite> {
+    /// Memory for the numeric factors of this pattern and their solves, allocated once.
+    pub(crate) fn workspace(&self) -> CholeskyWorkspace {
+        let par = get_global_parallelism();
+        let scratch = self
+            .symbolic
+            .factorize_numeric_llt_scratch::<f64>(par, Default::default())
+            .or(self.symbolic.solve_in_place_scratch::<f64>(1, par));
+        CholeskyWorkspace { values: vec![0.0; self.symbolic.len_val()], scratch: MemBuffer::new(scratch) }
+    }
+
+    /// The Cholesky factor of the symmetric matrix with lower-triangle `values`, in `workspace`
+    /// (no allocation: the factor of a 50 x 50 cloth takes tens of MB, whose fresh pages cost
+    /// about as much as the factorization).
+    pub(crate) fn factor<'w>(
+        &'w self,
+        values: &[f64],
+        workspace: &'w mut CholeskyWorkspace,
+    ) -> Result<Cholesky<'w>, NotPositiveDefinite> {
         let matrix = SparseColMatRef::new(self.structure.as_ref(), values);
-        Llt::try_new_with_symbolic(self.symbolic.clone(), matrix, Side::Lower)
-            .map(Cholesky)
-            .map_err(|_| NotPositiveDefinite)
+        let par = get_global_parallelism();
+        self.symbolic
+            .factorize_numeric_llt(
+                &mut workspace.values,
+                matrix,
+                Side::Lower,
+                Default::default(),
+                par,
+                MemStack::new(&mut workspace.scratch),
+                Default::default(),
+            )
+            .map_err(|_| NotPositiveDefinite)?;
+        Ok(Cholesky {
+            factor: LltRef::new(&self.symbolic, &workspace.values),
+            scratch: &mut workspace.scratch,
+        })
     }
 }
 
-/// A Cholesky factorization on a [`HessianPattern`].
-pub(crate) struct Cholesky(Llt<usize, f64>);
+/// The numeric factor's values and the scratch memory of factorizations and solves on one
+/// [`HessianPattern`].
+pub(crate) struct CholeskyWorkspace {
+    values: Vec<f64>,
+    scratch: MemBuffer,
+}
 
-impl Cholesky {
+/// A Cholesky factorization on a [`HessianPattern`].
+pub(crate) struct Cholesky<'w> {
+    factor: LltRef<'w, usize, f64>,
+    scratch: &'w mut MemBuffer,
+}
+
+impl Cholesky<'_> {
     /// Solve `A x = b` in place (`b` in, `x` out).
-    pub(crate) fn solve_in_place(&self, b: &mut [f64]) {
+    pub(crate) fn solve_in_place(&mut self, b: &mut [f64]) {
         let rows = b.len();
-        self.0.solve_in_place(MatMut::from_column_major_slice_mut(b, rows, 1));
+        self.factor.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(b, rows, 1),
+            get_global_parallelism(),
+            MemStack::new(self.scratch),
+        );
     }
 }
 
