@@ -9,12 +9,10 @@
 //! Self-collision (repulsion method, not a barrier): every pair of vertices closer than the
 //! self thickness `δ_s` in space whose material distance is at least [`SELF_EXCLUSION`] `δ_s`
 //! (so mesh neighbours never repel) stores `½ k_s (δ_s - r)²`. Pairs are found with a uniform
-//! hash grid. Only the vertex-diagonal blocks `k_s u uᵀ` of its Hessian enter the Newton matrix,
+//! grid of cells (sorted by column, see [`SelfCollision::pairs`]). Only the vertex-diagonal blocks `k_s u uᵀ` of its Hessian enter the Newton matrix,
 //! which keeps the sparsity pattern fixed; the line search uses the exact energy. Being
 //! vertex-vertex, it does not stop an edge or a face from passing between two vertices that
 //! are further apart than `δ_s`: choose `δ_s` near the mesh spacing.
-
-use std::collections::HashMap;
 
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
@@ -170,22 +168,17 @@ impl SelfCollision {
         })
     }
 
-    /// The repelling pairs at positions `x`, sorted.
+    /// The repelling pairs at positions `x`, sorted. Candidates come from a grid of cells at
+    /// least one thickness wide: vertices sorted by their cell's `(x, y)` column and then by
+    /// height, a dense index of where each column starts, so each vertex finds the vertices of
+    /// its 27 neighbouring cells in 9 column slices.
     pub fn pairs(&self, x: &[Vector3<f64>]) -> Vec<RepulsionPair> {
-        let cell = self.thickness;
-        let key = |p: &Vector3<f64>| [0, 1, 2].map(|k| (p[k] / cell).floor() as i64);
-        let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
-        for (i, p) in x.iter().enumerate() {
-            grid.entry(key(p)).or_default().push(i);
-        }
+        let grid = ColumnGrid::new(x, self.thickness);
         let mut pairs = Vec::new();
         for (i, p) in x.iter().enumerate() {
-            let [a, b, c] = key(p);
-            for (da, db, dc) in
-                (-1..=1).flat_map(|a| (-1..=1).flat_map(move |b| (-1..=1).map(move |c| (a, b, c))))
-            {
-                let Some(bucket) = grid.get(&[a + da, b + db, c + dc]) else { continue };
-                for &j in bucket.iter().filter(|&&j| j > i) {
+            let ([column_x, column_y], height) = grid.cell(p);
+            for (dx, dy) in (-1..=1).flat_map(|a| (-1..=1).map(move |b| (a, b))) {
+                for j in grid.neighbours(column_x + dx, column_y + dy, height).filter(|&j| j > i) {
                     let r = x[j] - p;
                     let distance = r.norm();
                     let apart =
@@ -223,6 +216,82 @@ impl SelfCollision {
                 blocks.push((v, block));
             }
         }
+    }
+}
+
+/// Points binned in cubic cells, sorted by `(x, y)` column and then by height, with a dense
+/// index of the columns over the points' bounding box.
+struct ColumnGrid {
+    width: f64,
+    origin: [f64; 2],
+    columns: [i64; 2],
+    /// `(height cell, point)` sorted by column, then height.
+    sorted: Vec<(i64, usize)>,
+    /// Where each column's points start in `sorted` (one more entry than columns).
+    starts: Vec<usize>,
+}
+
+impl ColumnGrid {
+    /// The grid of `x` with cells `min_width` wide, or wider where the box would need more
+    /// than 4 columns per point (a far-flung vertex must not allocate a huge index).
+    fn new(x: &[Vector3<f64>], min_width: f64) -> Self {
+        let (mut low, mut high) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in x {
+            for k in 0..2 {
+                low[k] = low[k].min(p[k]);
+                high[k] = high[k].max(p[k]);
+            }
+        }
+        let mut width = min_width;
+        let count = |width: f64| {
+            [0, 1].map(|k| (((high[k] - low[k]) / width).floor().max(0.0) as i64).saturating_add(1))
+        };
+        while count(width)[0].saturating_mul(count(width)[1]) > 4 * x.len().max(1) as i64 {
+            width *= 2.0;
+        }
+        let mut grid =
+            Self { width, origin: low, columns: count(width), sorted: Vec::new(), starts: Vec::new() };
+        let mut keyed: Vec<(usize, i64, usize)> = x
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let ([cx, cy], height) = grid.cell(p);
+                ((cx + grid.columns[0] * cy) as usize, height, i)
+            })
+            .collect();
+        keyed.sort_unstable();
+        let column_count = (grid.columns[0] * grid.columns[1]) as usize;
+        grid.starts = vec![0; column_count + 1];
+        for &(column, _, _) in &keyed {
+            grid.starts[column + 1] += 1;
+        }
+        for c in 0..column_count {
+            grid.starts[c + 1] += grid.starts[c];
+        }
+        grid.sorted = keyed.into_iter().map(|(_, height, i)| (height, i)).collect();
+        grid
+    }
+
+    /// The `(x, y)` column and the height cell of `p`.
+    fn cell(&self, p: &Vector3<f64>) -> ([i64; 2], i64) {
+        let column = [0, 1].map(|k| ((p[k] - self.origin[k]) / self.width).floor() as i64);
+        (column, (p[2] / self.width).floor() as i64)
+    }
+
+    /// The points in column `(cx, cy)` within one cell of height `height`.
+    fn neighbours(&self, cx: i64, cy: i64, height: i64) -> impl Iterator<Item = usize> + '_ {
+        let inside = (0..self.columns[0]).contains(&cx) && (0..self.columns[1]).contains(&cy);
+        let slice = match inside {
+            true => {
+                let column = (cx + self.columns[0] * cy) as usize;
+                let points = &self.sorted[self.starts[column]..self.starts[column + 1]];
+                let first = points.partition_point(|&(h, _)| h < height - 1);
+                let end = points.partition_point(|&(h, _)| h <= height + 1);
+                &points[first..end]
+            }
+            false => &[],
+        };
+        slice.iter().map(|&(_, i)| i)
     }
 }
 
@@ -277,6 +346,47 @@ mod tests {
                 - self_collision.energy(&self_collision.pairs(&m)))
                 / (2.0 * h);
             assert!((gradient[dof] - fd).abs() < 1e-6, "dof {dof}: {} vs {fd}", gradient[dof]);
+        }
+    }
+
+    #[test]
+    fn the_column_grid_finds_every_pair_a_brute_force_search_finds() {
+        use crate::test_support::XorShift;
+        let mut rng = XorShift::new(7);
+        let settings = ContactSettings {
+            thickness_m: 0.0,
+            stiffness_n_m: 0.0,
+            friction: 0.0,
+            self_thickness_m: 0.01,
+            self_stiffness_n_m: 1.0,
+        };
+        // A crumpled sheet: material coordinates on a grid, positions folded into a small box;
+        // then the same with one vertex far away, which coarsens the grid.
+        let material: Vec<_> = (0..400)
+            .map(|i| nalgebra::Vector2::new((i % 20) as f64 * 0.01, (i / 20) as f64 * 0.01))
+            .collect();
+        let mut x: Vec<_> = (0..400)
+            .map(|_| {
+                Vector3::new(rng.uniform(-0.04, 0.04), rng.uniform(-0.04, 0.04), rng.uniform(-0.02, 0.02))
+            })
+            .collect();
+        let collision = SelfCollision::new(&settings, &material).expect("enabled");
+        for far in [None, Some(Vector3::new(1e3, -2e3, 5.0))] {
+            if let Some(p) = far {
+                x[17] = p;
+            }
+            let mut expected = Vec::new();
+            for i in 0..x.len() {
+                for j in i + 1..x.len() {
+                    let d = (x[j] - x[i]).norm();
+                    if d < 0.01 && d > 0.0 && (material[j] - material[i]).norm() >= SELF_EXCLUSION * 0.01 {
+                        expected.push([i, j]);
+                    }
+                }
+            }
+            let found: Vec<_> = collision.pairs(&x).iter().map(|p| p.vertices).collect();
+            assert!(expected.len() > 100, "{}", expected.len());
+            assert_eq!(found, expected);
         }
     }
 }
