@@ -4,20 +4,20 @@
 //! `Φ(x) = Σ m_i |x_i - x̂_i|² / (2h²) + E(x) + E_contact(x) - Σ m_i g·x_i + Φ_damp(x)`,
 //! `x̂ = x_n + h v_n`,
 //!
-//! by Newton's method with a backtracking line search. `E` is the elastic energy; its element
-//! Hessians enter the Newton matrix with their eigenvalues replaced by their absolute values
-//! (Chen et al. 2024; from the same states of the published stretch and drape scenes, about a
-//! fifth fewer Newton iterations than with the eigenvalues clamped to zero), which changes the
-//! path to the minimum of `Φ`, not the minimum. [`NewtonMatrix::GaussNewton`] takes Gauss-Newton
-//! element matrices in the forms instead, positive semidefinite without the 18 x 18
-//! eigensolver (same `Φ`, same minimum). Rayleigh damping `D = α M + β K_n` (`K_n` the elastic
-//! Gauss-Newton matrix at the start of the step, positive semidefinite by construction) enters as
-//! `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
+//! by Newton's method with a backtracking line search, from `x̂` or `x_n`
+//! ([`Simulation::step`]). `E` is the elastic energy; the Newton matrix takes its element
+//! matrices as [`Dynamics::newton_matrix`] says: Gauss-Newton in the forms (the default,
+//! positive semidefinite without an 18 x 18 eigensolver), or the exact Hessians with their
+//! eigenvalues replaced by their absolute values (Chen et al. 2024; from the same states of the
+//! published stretch and drape scenes, about a fifth fewer Newton iterations than with the
+//! eigenvalues clamped to zero). Either changes the path to the minimum of `Φ`, not the minimum.
+//! Rayleigh damping `D = α M + β K` (`K` the elastic Gauss-Newton matrix at Newton's starting
+//! point, positive semidefinite by construction) enters as `Φ_damp = (x - x_n)ᵀ D (x - x_n) / (2h)`.
 //! Handle vertices follow their scripted positions and are removed from the unknowns. The
 //! Newton matrices are assembled straight into one sparsity pattern (the mesh's element
 //! couplings and vertex blocks) and solved by faer's sparse Cholesky on its symbolic analysis,
-//! both computed once ([`crate::pattern`]). Friction against obstacles is applied to the
-//! new velocities ([`crate::contact`]).
+//! both computed once, in memory kept from step to step (module `newton_matrix`). Friction
+//! against obstacles is applied to the new velocities ([`crate::contact`]).
 
 use std::time::Instant;
 
