@@ -2,8 +2,10 @@
 //! and drape scenes (built-ins `stretch-x`, `drape`) at 50 x 50 = 2500 vertices, with the
 //! published ARCSim-HYLC stockinette material (`stock1.json`), one thread (`RAYON_NUM_THREADS=1`
 //! gives the single-core figure) or all: at the built-ins' Δt = 4.2 ms (4 steps per 1/60 s frame)
-//! with either Newton matrix (`gauss-newton`, the default, and `projected`), and at the published
-//! scenes' own Δt = 0.209 ms (80 steps per frame, `frame_steps` in `stock_stretchX.json`).
+//! with either Newton matrix (`gauss-newton`, the default, and `projected`; the default linear
+//! solver factors there), and at the published scenes' own Δt = 0.209 ms (80 steps per frame,
+//! `frame_steps` in `stock_stretchX.json`) with the default linear solver (conjugate gradients
+//! there) and with Cholesky.
 //! Compared with: thesis Table 4.2, HYLC in ARCSim 0.41-1.15 s per step at 2.1k-4.4k vertices
 //! (at Δt = 0.209 ms); target 10x faster, under 0.05 s per step on one core.
 //! Each sample is the mean over the same 10 steps, restarted from the same state (after 10 steps
@@ -18,7 +20,7 @@ use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::simulate::prepare;
-use yarnhom_shell::{Scene, ShellMaterial, Simulation};
+use yarnhom_shell::{LinearSolver, Scene, ShellMaterial, Simulation};
 
 /// Steps in the measured window.
 const WINDOW: u32 = 10;
@@ -45,17 +47,19 @@ fn run_window(sim: &mut Simulation, state: &State) -> (Duration, u32) {
 fn bench_steps(c: &mut Criterion) {
     let mut g = c.benchmark_group("shell time step");
     g.sample_size(10);
-    // (matrix, its name, steps per frame, steps before the window)
+    // (matrix, linear solver, their names, steps per frame, steps before the window)
     let cases = [
-        (NewtonMatrix::GaussNewton, "gauss-newton", 4, 10),
-        (NewtonMatrix::Projected, "projected", 4, 10),
-        (NewtonMatrix::GaussNewton, "gauss-newton", 80, 200),
+        (NewtonMatrix::GaussNewton, LinearSolver::Auto, "gauss-newton, auto", 4, 10),
+        (NewtonMatrix::Projected, LinearSolver::Auto, "projected, auto", 4, 10),
+        (NewtonMatrix::GaussNewton, LinearSolver::Auto, "gauss-newton, auto", 80, 200),
+        (NewtonMatrix::GaussNewton, LinearSolver::Cholesky, "gauss-newton, cholesky", 80, 200),
     ];
-    for (name, (matrix, matrix_name, steps_per_frame, settle)) in
+    for (name, (matrix, solver, solver_name, steps_per_frame, settle)) in
         ["stretch-x", "drape"].into_iter().flat_map(|n| cases.map(|c| (n, c)))
     {
         let mut scene = Scene::builtin(name).expect("builtin");
         scene.newton_matrix = matrix;
+        scene.linear_solver = solver;
         scene.steps_per_frame = steps_per_frame;
         let mut sim = prepare(&scene, stock()).expect("scene");
         for _ in 0..settle {
@@ -64,7 +68,7 @@ fn bench_steps(c: &mut Criterion) {
         let state = (sim.positions.clone(), sim.velocities.clone(), sim.time_s);
         let (_, iterations) = run_window(&mut sim, &state);
         eprintln!(
-            "{name}, {matrix_name}: {} vertices, {} triangles, dt {} s, {:.1} Newton iterations per step (steps {}-{}), {} threads",
+            "{name}, {solver_name}: {} vertices, {} triangles, dt {} s, {:.1} Newton iterations per step (steps {}-{}), {} threads",
             sim.positions.len(),
             sim.model.mesh.triangles.len(),
             scene.dt_s(),
@@ -74,7 +78,7 @@ fn bench_steps(c: &mut Criterion) {
             rayon::current_num_threads()
         );
         let dt_ms = 1e3 * scene.dt_s();
-        g.bench_function(format!("{name}, 2500 vertices, stock1, {matrix_name}, dt {dt_ms:.3} ms"), |b| {
+        g.bench_function(format!("{name}, 2500 vertices, stock1, {solver_name}, dt {dt_ms:.3} ms"), |b| {
             b.iter_custom(|samples| (0..samples).map(|_| run_window(&mut sim, &state).0).sum())
         });
     }

@@ -11,7 +11,7 @@ use serde::Deserialize;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::simulate::{FrameReport, run as run_scene};
-use yarnhom_shell::{HingeBending, Scene, ShellMaterial, Simulation, StvkNeoHookean};
+use yarnhom_shell::{HingeBending, LinearSolver, Scene, ShellMaterial, Simulation, StvkNeoHookean};
 use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceMetadata};
 
 use crate::Outcome;
@@ -56,6 +56,32 @@ pub struct SimulateArgs {
     /// Gauss-Newton in the forms (faster, no 18 x 18 eigensolver; the same states).
     #[arg(long, value_enum)]
     pub newton_matrix: Option<NewtonMatrixArg>,
+    /// The Newton system's solver (overrides the scene): `auto` takes Jacobi-preconditioned
+    /// conjugate gradients where their bound iteration count costs less than a sparse Cholesky
+    /// factorization (short time steps), else the factorization.
+    #[arg(long, value_enum)]
+    pub linear_solver: Option<LinearSolverArg>,
+}
+
+/// [`LinearSolver`] on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum LinearSolverArg {
+    /// `auto`.
+    Auto,
+    /// `cholesky`.
+    Cholesky,
+    /// `conjugate-gradient`.
+    ConjugateGradient,
+}
+
+impl From<LinearSolverArg> for LinearSolver {
+    fn from(arg: LinearSolverArg) -> Self {
+        match arg {
+            LinearSolverArg::Auto => LinearSolver::Auto,
+            LinearSolverArg::Cholesky => LinearSolver::Cholesky,
+            LinearSolverArg::ConjugateGradient => LinearSolver::ConjugateGradient,
+        }
+    }
 }
 
 /// [`NewtonMatrix`] on the command line.
@@ -126,11 +152,13 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     }
     scene.steps_per_frame = args.steps_per_frame.unwrap_or(scene.steps_per_frame);
     scene.newton_matrix = args.newton_matrix.map_or(scene.newton_matrix, NewtonMatrix::from);
+    scene.linear_solver = args.linear_solver.map_or(scene.linear_solver, LinearSolver::from);
     let material = load_material(&args.material)?;
     let metadata = TraceMetadata::new("yarnhom shell simulate", env!("CARGO_PKG_VERSION"))
         .with_entry("scene", &args.scene)
         .with_entry("material", args.material.display().to_string())
-        .with_entry("newton_matrix", serde_json::to_value(scene.newton_matrix)?.as_str().unwrap_or_default());
+        .with_entry("newton_matrix", serde_json::to_value(scene.newton_matrix)?.as_str().unwrap_or_default())
+        .with_entry("linear_solver", serde_json::to_value(scene.linear_solver)?.as_str().unwrap_or_default());
     let mut trace = TraceSink::open(&args.output, &metadata)?;
     let total = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
     let bar = ProgressBar::new(total);
@@ -143,6 +171,7 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     }
     let mut newton_total = 0u64;
     let mut steps_total = 0u64;
+    let (mut cg_total, mut factorizations_total) = (0u64, 0u64);
     let sim = run_scene(&scene, material, args.frames, |report, sim| {
         if report.frame == 0 {
             trace.write(&topology(sim, &scene.name)).map_err(|e| e.to_string())?;
@@ -154,6 +183,9 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
         }
         newton_total += report.steps.iter().map(|s| u64::from(s.newton_iterations)).sum::<u64>();
         steps_total += report.steps.len() as u64;
+        cg_total += report.steps.iter().map(|s| u64::from(s.linear_solves.cg_iterations)).sum::<u64>();
+        factorizations_total +=
+            report.steps.iter().map(|s| u64::from(s.linear_solves.factorizations)).sum::<u64>();
         bar.set_position(report.frame);
         bar.set_message(format!("E {:.3e} J", report.elastic_energy_j));
         Ok(())
@@ -161,10 +193,13 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     bar.finish_and_clear();
     trace.finish()?;
     eprintln!(
-        "simulated {} s in {} steps ({} Newton iterations), {} vertices; elastic energy {:.4e} J",
+        "simulated {} s in {} steps ({} Newton iterations; linear solves: {} conjugate gradient iterations, {} \
+         Cholesky factorizations), {} vertices; elastic energy {:.4e} J",
         sim.time_s,
         steps_total,
         newton_total,
+        cg_total,
+        factorizations_total,
         sim.positions.len(),
         sim.model.energy(&sim.positions)
     );
@@ -192,6 +227,14 @@ fn write_frame(
         ("kinetic_energy_j".to_string(), report.kinetic_energy_j),
         ("gravity_energy_j".to_string(), report.gravity_energy_j),
         ("penetration_m".to_string(), report.penetration_m),
+        (
+            "cg_iterations".to_string(),
+            report.steps.iter().map(|s| f64::from(s.linear_solves.cg_iterations)).sum(),
+        ),
+        (
+            "cholesky_factorizations".to_string(),
+            report.steps.iter().map(|s| f64::from(s.linear_solves.factorizations)).sum(),
+        ),
     ]);
     trace.write(&Scalars { frame: report.frame, time_s: report.time_s, values })?;
     for s in &report.steps {

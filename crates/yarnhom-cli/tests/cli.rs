@@ -554,11 +554,22 @@ fn published_materials_round_trip_and_simulate_into_a_streamed_trace() {
         let args = ["shell", "simulate", "scene.json", "--material", published.as_str(), "--frames", "1"];
         yarnhom(&[&args[..], extra].concat(), dir.path())
     };
-    let out = simulate_scene(&["-o", "s.mcap", "--resolution", "7", "--newton-matrix", "gauss-newton"]);
+    let out = simulate_scene(&[
+        "-o",
+        "s.mcap",
+        "--resolution",
+        "7",
+        "--newton-matrix",
+        "gauss-newton",
+        "--linear-solver",
+        "cholesky",
+    ]);
     assert!(out.status.success(), "{}", stderr(&out));
+    assert!(stderr(&out).contains("0 conjugate gradient iterations"), "{}", stderr(&out));
     let trace = std::fs::read(dir.path().join("s.mcap")).expect("trace");
     let metadata = yarnhom_trace::read_metadata(&trace).expect("metadata");
     assert_eq!(metadata[0].entries["newton_matrix"], "gauss-newton");
+    assert_eq!(metadata[0].entries["linear_solver"], "cholesky");
     let out = simulate_scene(&["-o", "t.mcap", "--newton-matrix", "exact"]);
     assert!(!out.status.success() && stderr(&out).contains("possible values: projected, gauss-newton"));
 

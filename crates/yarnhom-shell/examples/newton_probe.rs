@@ -1,8 +1,8 @@
 //! Newton convergence of the shell integrator on a built-in scene with a published material:
 //! per step the iterations, line-search halvings, final residual and wall time.
 //! `cargo run --release -p yarnhom-shell --example newton_probe -- SCENE MATERIAL N STEPS [TOLERANCE_M]
-//! [projected|gauss-newton] [STEPS_PER_FRAME]` (the published scenes take 80 steps per 1/60 s frame, Δt = 0.209 ms;
-//! the built-ins 4). With `PROBE_DUMP=FILE` it writes the final positions, one vertex `x y z` per
+//! [projected|gauss-newton] [STEPS_PER_FRAME] [auto|cholesky]` (the published scenes take 80 steps per 1/60 s
+//! frame, Δt = 0.209 ms; the built-ins 4; the last argument is the linear solver). With `PROBE_DUMP=FILE` it writes the final positions, one vertex `x y z` per
 //! line, to compare runs (the README's accuracy figures for one Newton iteration per step).
 
 use yarnhom_artifacts::arcsim::read_spline;
@@ -31,12 +31,24 @@ fn main() {
     if let Some(steps) = args.get(7).and_then(|a| a.parse().ok()) {
         scene.steps_per_frame = steps;
     }
+    if let Some(solver) = args.get(8) {
+        scene.linear_solver =
+            serde_json::from_value(serde_json::Value::String(solver.clone())).expect("auto or cholesky");
+    }
     let mut sim = prepare(&scene, ShellMaterial::spline(SplineMaterial::from(&spline))).expect("scene");
     for _ in 0..steps {
         let s = sim.step().expect("step");
         println!(
-            "t {:.4} s: {:2} Newton iterations, {:2} halvings, residual {:.2e} N, converged {}, {:.3} s",
-            sim.time_s, s.newton_iterations, s.line_search_steps, s.residual_n, s.converged, s.wall_time_s
+            "t {:.4} s: {:2} Newton iterations, {:2} halvings, {:3} CG iterations, {} factorizations, residual \
+             {:.2e} N, converged {}, {:.3} s",
+            sim.time_s,
+            s.newton_iterations,
+            s.line_search_steps,
+            s.linear_solves.cg_iterations,
+            s.linear_solves.factorizations,
+            s.residual_n,
+            s.converged,
+            s.wall_time_s
         );
     }
     if let Ok(path) = std::env::var("PROBE_DUMP") {

@@ -16,7 +16,8 @@
 //! Handle vertices follow their scripted positions and are removed from the unknowns. The
 //! Newton matrices are assembled straight into one sparsity pattern (the mesh's element
 //! couplings and vertex blocks) and solved by faer's sparse Cholesky on its symbolic analysis,
-//! both computed once, in memory kept from step to step (module `newton_matrix`). Friction
+//! both computed once, in memory kept from step to step (module `newton_matrix`), or by
+//! conjugate gradients where the inertia term makes them cheaper ([`crate::linear_solver`]). Friction
 //! against obstacles is applied to the new velocities ([`crate::contact`]).
 
 use std::time::Instant;
@@ -26,6 +27,10 @@ use nalgebra::{Matrix3, Vector3};
 use crate::contact::{ContactSettings, Obstacle, SelfCollision, obstacle_contacts};
 use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;
+use crate::linear_solver::{
+    CG_ERROR_SHARE, LinearSolver, LinearSolves, conjugate_gradient, factorization_cost_in_iterations,
+    jacobi_condition_bound, predicted_iterations,
+};
 use crate::newton_matrix::{CholeskyWorkspace, HessianPattern, NewtonAssembly};
 
 /// Newton starts at the inertial prediction when it moves no vertex by more than this many
@@ -85,6 +90,8 @@ pub struct Dynamics {
     /// The element matrices of the Newton matrix (the stiffness damping matrix always takes the
     /// Gauss-Newton ones).
     pub newton_matrix: NewtonMatrix,
+    /// How the Newton system is solved.
+    pub linear_solver: LinearSolver,
 }
 
 /// What one step did.
@@ -96,6 +103,8 @@ pub struct StepStats {
     pub residual_n: f64,
     /// Line-search halvings over all iterations.
     pub line_search_steps: u32,
+    /// The linear solves' work over all iterations.
+    pub linear_solves: LinearSolves,
     /// Whether Newton met its tolerance.
     pub converged: bool,
     /// Wall time (s).
@@ -140,7 +149,10 @@ pub struct Simulation {
     pattern: HessianPattern,
     /// The slots of the Newton matrix in the rows and columns of the fixed DOFs.
     pinned: Vec<usize>,
-    /// The Cholesky factor's memory, kept from step to step.
+    /// Per DOF, the inertia term of the Newton matrix's diagonal, `m/h² + α m/h` (fixed DOFs:
+    /// 1, their whole diagonal).
+    inertia: Vec<f64>,
+    /// The Cholesky factor's memory, kept from step to step once a step factors.
     cholesky: Option<CholeskyWorkspace>,
 }
 
@@ -173,6 +185,10 @@ impl Simulation {
         let self_collision = SelfCollision::new(&contact, &model.mesh.material);
         let pattern = HessianPattern::new(positions.len(), &model.element_vertices());
         let pinned = pattern.slots_touching(&fixed);
+        let (h, alpha) = (dynamics.dt_s, dynamics.mass_damping);
+        let inertia = (0..fixed.len())
+            .map(|dof| if fixed[dof] { 1.0 } else { masses[dof / 3] * (1.0 / (h * h) + alpha / h) })
+            .collect();
         Self {
             velocities: vec![Vector3::zeros(); positions.len()],
             positions,
@@ -187,6 +203,7 @@ impl Simulation {
             dynamics,
             pattern,
             pinned,
+            inertia,
             cholesky: None,
             model,
         }
@@ -238,24 +255,21 @@ impl Simulation {
             newton_iterations: 0,
             residual_n: 0.0,
             line_search_steps: 0,
+            linear_solves: LinearSolves::default(),
             converged: false,
             wall_time_s: 0.0,
         };
         // One buffer for every iteration's assembly, so its memory is allocated once per step.
         let mut a = NewtonAssembly::new(&self.pattern);
-        let mut workspace = self.cholesky.take().unwrap_or_else(|| self.pattern.workspace());
+        let mut cholesky = self.cholesky.take();
         // Φ at the current iterate, when the last line search computed it.
         let mut phi: Option<f64> = None;
         for iteration in 0..self.dynamics.max_newton_iterations {
             self.assemble(&x, &mut terms, iteration == 0, &mut a);
             self.pin(&mut a);
             stats.residual_n = a.gradient.iter().fold(0.0_f64, |m, g| m.max(g.abs()));
-            let mut factor = self
-                .pattern
-                .factor(&a.matrix, &mut workspace)
-                .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
             let mut dx: Vec<f64> = a.gradient.iter().map(|g| -g).collect();
-            factor.solve_in_place(&mut dx);
+            self.solve_newton_system(&a.matrix, &mut dx, &mut cholesky, &mut stats.linear_solves)?;
             // The assembly's energy is `E(x)` (the first iteration's; later ones reuse the line
             // search's `Φ`).
             let phi0 = phi.unwrap_or_else(|| a.energy + self.potential_besides_elastic(&x, &terms));
@@ -279,10 +293,75 @@ impl Simulation {
                 break;
             }
         }
-        self.cholesky = Some(workspace);
+        self.cholesky = cholesky;
         self.finish_step(x, &terms.start, next_time);
         stats.wall_time_s = started.elapsed().as_secs_f64();
         Ok(stats)
+    }
+
+    /// Replace `b` by the solution of `A x = b`, `A` the Newton matrix with lower-triangle
+    /// `matrix` on the pattern, as [`Dynamics::linear_solver`] says (a factorization's memory
+    /// in `cholesky`, allocated on the first).
+    fn solve_newton_system(
+        &self,
+        matrix: &[f64],
+        b: &mut Vec<f64>,
+        cholesky: &mut Option<CholeskyWorkspace>,
+        solves: &mut LinearSolves,
+    ) -> Result<(), StepError> {
+        let cg = match self.dynamics.linear_solver {
+            LinearSolver::Auto => self.conjugate_gradient_solve(matrix, b, true, solves),
+            LinearSolver::ConjugateGradient => self.conjugate_gradient_solve(matrix, b, false, solves),
+            LinearSolver::Cholesky => None,
+        };
+        if let Some(x) = cg {
+            *b = x;
+            return Ok(());
+        }
+        let workspace = cholesky.get_or_insert_with(|| self.pattern.workspace());
+        let mut factor = self
+            .pattern
+            .factor(matrix, workspace)
+            .map_err(|_| StepError::Factorization { time_s: self.time_s })?;
+        solves.factorizations += 1;
+        factor.solve_in_place(b);
+        Ok(())
+    }
+
+    /// The solution of `A x = b` by Jacobi-preconditioned conjugate gradients, to an error
+    /// below [`CG_ERROR_SHARE`] Newton tolerances, if they converge. With `within_cost`, only
+    /// when the bound on their iterations is below the cost of a factorization, and within that
+    /// cost ([`crate::linear_solver`]); else within as many iterations as DOFs.
+    fn conjugate_gradient_solve(
+        &self,
+        matrix: &[f64],
+        b: &[f64],
+        within_cost: bool,
+        solves: &mut LinearSolves,
+    ) -> Option<Vec<f64>> {
+        let smallest_inertia = self
+            .inertia
+            .iter()
+            .zip(&self.fixed)
+            .filter(|(_, fixed)| !**fixed)
+            .fold(f64::INFINITY, |m, (c, _)| m.min(*c));
+        let tolerance = CG_ERROR_SHARE * self.dynamics.tolerance_m * smallest_inertia;
+        let mut x = vec![0.0; b.len()];
+        let b_norm = dot(b, b).sqrt();
+        if b_norm <= tolerance {
+            return Some(x);
+        }
+        let mut budget = b.len() as f64;
+        if within_cost {
+            budget = factorization_cost_in_iterations(&self.pattern);
+            let kappa = jacobi_condition_bound(&self.pattern, matrix, &self.inertia);
+            if predicted_iterations(kappa, tolerance / b_norm) > budget {
+                return None;
+            }
+        }
+        let run = conjugate_gradient(&self.pattern, matrix, b, &mut x, tolerance, budget as u32);
+        solves.cg_iterations += run.iterations;
+        run.converged.then_some(x)
     }
 
     /// Where Newton starts, handles at their positions at `time_s`: at the inertial prediction

@@ -9,7 +9,8 @@
 //! - [`scene`], [`arcsim_scene`]: scene files, built-ins and the published ARCSim scenes.
 //! - [`simulate`]: running a scene frame by frame.
 //! - [`integrator`]: implicit Euler with Newton and line search, handles, Rayleigh damping;
-//!   its Newton matrices on one sparsity pattern (`pattern`).
+//!   its Newton matrices on one sparsity pattern (`newton_matrix`), solved by Cholesky or
+//!   conjugate gradients ([`linear_solver`]).
 //! - [`statics`]: static equilibrium with held DOFs (clamped swatch tests).
 
 pub mod arcsim_scene;
@@ -20,6 +21,7 @@ pub mod forms;
 pub mod hinge;
 pub mod integrator;
 mod line_search;
+pub mod linear_solver;
 pub mod material;
 pub mod mesh;
 mod newton_matrix;
@@ -31,6 +33,7 @@ mod test_support;
 
 pub use elastic::{Assembly, ElasticModel};
 pub use integrator::{Dynamics, Handle, Motion, Simulation, StepStats};
+pub use linear_solver::{LinearSolver, LinearSolves};
 pub use material::{HingeBending, ShellMaterial, Stiffening, StvkNeoHookean};
 pub use mesh::ShellMesh;
 pub use scene::Scene;

@@ -5,7 +5,9 @@
 //! factorization (faer) reuses the pattern's symbolic analysis.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{
+    LltRef, SymbolicCholesky, SymbolicCholeskyRaw, factorize_symbolic_cholesky,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Side, get_global_parallelism};
 
@@ -23,6 +25,8 @@ pub(crate) struct NotPositiveDefinite;
 pub(crate) struct HessianPattern {
     structure: SymbolicSparseColMat<usize>,
     symbolic: SymbolicCholesky<usize>,
+    /// Flops of a numeric factorization and one solve with it.
+    factorization_flops: f64,
     /// Per element, the slot of each entry `(i, j)`, `j <= i`, of its local lower triangle in
     /// row-major order ([`ABSENT`] where a vertex is absent); element `e`'s slots start at
     /// `element_starts[e]`.
@@ -65,7 +69,14 @@ impl HessianPattern {
             Default::default(),
         )
         .unwrap_or_else(|e| unreachable!("a valid pattern has a symbolic Cholesky factor: {e:?}"));
-        let mut pattern = Self { structure, symbolic, element_slots: Vec::new(), element_starts: Vec::new() };
+        let factorization_flops = factorization_flops(&symbolic);
+        let mut pattern = Self {
+            structure,
+            symbolic,
+            factorization_flops,
+            element_slots: Vec::new(),
+            element_starts: Vec::new(),
+        };
         for element in elements {
             pattern.element_starts.push(pattern.element_slots.len());
             let slots = pattern.local_slots(element);
@@ -77,6 +88,16 @@ impl HessianPattern {
     /// How many values the pattern holds.
     pub(crate) fn len(&self) -> usize {
         self.structure.row_idx().len()
+    }
+
+    /// How many DOFs (rows and columns) the pattern has.
+    pub(crate) fn dofs(&self) -> usize {
+        self.structure.ncols()
+    }
+
+    /// Flops of a numeric Cholesky factorization on the pattern and one solve with it.
+    pub(crate) fn factorization_flops(&self) -> f64 {
+        self.factorization_flops
     }
 
     /// The slot of entry `(row, col)`, `row >= col`, of the pattern.
@@ -124,9 +145,26 @@ impl HessianPattern {
             .collect()
     }
 
+    /// `f(row, col, value)` for every stored entry (`row >= col`) of `values` on the pattern.
+    pub(crate) fn for_each_entry(&self, values: &[f64], mut f: impl FnMut(usize, usize, f64)) {
+        for col in 0..self.structure.ncols() {
+            let range = self.structure.col_range(col);
+            for (&row, &a) in self.structure.row_idx()[range.clone()].iter().zip(&values[range]) {
+                f(row, col, a);
+            }
+        }
+    }
+
     /// `A v` for the symmetric `A` with lower-triangle `values` on the pattern.
     pub(crate) fn symmetric_product(&self, values: &[f64], v: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; v.len()];
+        self.symmetric_product_into(values, v, &mut out);
+        out
+    }
+
+    /// `out = A v` for the symmetric `A` with lower-triangle `values` on the pattern.
+    pub(crate) fn symmetric_product_into(&self, values: &[f64], v: &[f64], out: &mut [f64]) {
+        out.fill(0.0);
         for (col, &v_col) in v.iter().enumerate() {
             let range = self.structure.col_range(col);
             let rows = &self.structure.row_idx()[range.clone()];
@@ -139,7 +177,6 @@ impl HessianPattern {
             }
             out[col] += sum;
         }
-        out
     }
 
     /// Memory for the numeric factors of this pattern and their solves, allocated once.
@@ -178,6 +215,22 @@ impl HessianPattern {
             scratch: &mut workspace.scratch,
         })
     }
+}
+
+/// Flops of a numeric factorization with `symbolic` (`Σ_j c_j²` over the factor's column
+/// counts `c_j`) and of one solve with it (`4 nnz(L)`).
+fn factorization_flops(symbolic: &SymbolicCholesky<usize>) -> f64 {
+    let columns: Vec<f64> = match symbolic.raw() {
+        SymbolicCholeskyRaw::Simplicial(s) => s.col_ptr().windows(2).map(|w| (w[1] - w[0]) as f64).collect(),
+        SymbolicCholeskyRaw::Supernodal(s) => (0..s.n_supernodes())
+            .flat_map(|k| {
+                let width = s.supernode_end()[k] - s.supernode_begin()[k];
+                let below = s.col_ptr_for_row_idx()[k + 1] - s.col_ptr_for_row_idx()[k];
+                (0..width).map(move |j| (width - j + below) as f64)
+            })
+            .collect(),
+    };
+    columns.iter().map(|c| c * c).sum::<f64>() + 4.0 * columns.iter().sum::<f64>()
 }
 
 /// The numeric factor's values and the scratch memory of factorizations and solves on one

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::contact::{ContactSettings, Obstacle};
 use crate::elastic::NewtonMatrix;
 use crate::integrator::{Dynamics, Handle, Motion};
+use crate::linear_solver::LinearSolver;
 use crate::mesh::ShellMesh;
 
 /// A simulation scene.
@@ -53,6 +54,9 @@ pub struct Scene {
     /// `projected`).
     #[serde(default)]
     pub newton_matrix: NewtonMatrix,
+    /// How the Newton system is solved (`auto`, the default, or `cholesky`).
+    #[serde(default)]
+    pub linear_solver: LinearSolver,
 }
 
 /// Which vertices a handle holds.
@@ -137,6 +141,7 @@ impl Scene {
             max_newton_iterations: 30,
             tolerance_m: 1e-4,
             newton_matrix: NewtonMatrix::default(),
+            linear_solver: LinearSolver::default(),
         };
         let bar = |side: u8, motion: usize| HandleSpec::Bar {
             side,
@@ -298,6 +303,7 @@ impl Scene {
             max_newton_iterations: self.max_newton_iterations,
             tolerance_m: self.tolerance_m,
             newton_matrix: self.newton_matrix,
+            linear_solver: self.linear_solver,
         }
     }
 }

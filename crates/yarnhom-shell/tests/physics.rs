@@ -6,9 +6,10 @@ use nalgebra::Vector3;
 use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::NewtonMatrix;
+use yarnhom_shell::linear_solver::CG_ERROR_SHARE;
 use yarnhom_shell::scene::HandleSpec;
 use yarnhom_shell::simulate::prepare;
-use yarnhom_shell::{Scene, ShellMaterial, Simulation};
+use yarnhom_shell::{LinearSolver, LinearSolves, Scene, ShellMaterial, Simulation};
 
 fn published(name: &str) -> ShellMaterial {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
@@ -223,4 +224,41 @@ fn short_steps_converge_in_one_newton_iteration_from_the_inertial_prediction() {
     let apart = loose.iter().zip(&tight).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
     eprintln!("after 60 steps: {apart:.2e} m from the converged states, which moved up to {travelled:.2e} m");
     assert!(apart < 0.02 * travelled, "{apart} m apart, {travelled} m travelled");
+}
+
+#[test]
+fn conjugate_gradients_take_short_steps_to_the_states_cholesky_takes() {
+    // At the published Δt the inertia term dominates the Newton matrix: `auto` solves every step
+    // by conjugate gradients, to an update error below `CG_ERROR_SHARE` Newton tolerances, and
+    // the states follow the factored ones. An update error `δ` in step `k` is also a velocity
+    // error `δ/h`, so it moves step `n` by up to `(n - k + 1) δ`: after `n` steps the states lie
+    // within `n (n + 1) / 2 · δ` of each other. At 4 steps per frame `auto` factors.
+    let (steps, tolerance) = (40, 1e-4);
+    let run = |solver: LinearSolver, steps_per_frame: u32| {
+        let mut s = scene("stretch-x", 11, steps_per_frame);
+        s.tolerance_m = tolerance;
+        s.linear_solver = solver;
+        let mut sim = prepare(&s, published("stock1")).expect("scene");
+        let mut total = LinearSolves::default();
+        for _ in 0..steps {
+            let stats = sim.step().expect("step");
+            assert!(stats.converged, "{solver:?}: {stats:?}");
+            total.cg_iterations += stats.linear_solves.cg_iterations;
+            total.factorizations += stats.linear_solves.factorizations;
+        }
+        (sim.positions, total)
+    };
+    let (factored, factored_work) = run(LinearSolver::Cholesky, 80);
+    assert_eq!(factored_work.cg_iterations, 0);
+    let bound = (steps * (steps + 1) / 2) as f64 * CG_ERROR_SHARE * tolerance;
+    for solver in [LinearSolver::Auto, LinearSolver::ConjugateGradient] {
+        let (iterated, work) = run(solver, 80);
+        assert_eq!(work.factorizations, 0, "{solver:?}: {work:?}");
+        assert!(work.cg_iterations >= steps, "{solver:?}: {work:?}");
+        let apart = iterated.iter().zip(&factored).map(|(a, b)| (a - b).amax()).fold(0.0, f64::max);
+        eprintln!("{solver:?}: {work:?}, {apart:.2e} m from the factored states (bound {bound:.2e} m)");
+        assert!(apart < bound, "{solver:?}: {apart} m apart");
+    }
+    let (_, long_steps) = run(LinearSolver::Auto, 4);
+    assert!(long_steps.factorizations >= steps && long_steps.cg_iterations == 0, "{long_steps:?}");
 }
