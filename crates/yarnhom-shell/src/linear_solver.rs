@@ -13,9 +13,9 @@
 //!   number `κ` is bounded and conjugate gradients need about `√κ/2 · ln(2√κ/ρ)` iterations to
 //!   reduce the residual by `ρ`.
 //!
-//! Short time steps make `C` dominate (`h = 0.209 ms`, the published scenes': `κ` about 10, a
-//! few dozen products with `A` instead of a factorization with 8 times `A`'s nonzeros); long ones
-//! make `K` dominate, where the factorization wins. The choice compares the predicted
+//! Short time steps make `C` dominate (`h = 0.209 ms`, the published scenes': `κ` at most
+//! 20-100, 12-20 products with `A` instead of a factorization with 8 times `A`'s nonzeros); long
+//! ones make `K` dominate (4.2 ms: bounds of 1600-21000), where the factorization wins. The choice compares the predicted
 //! iterations with the cost of a factorization counted in products with `A`.
 
 use serde::{Deserialize, Serialize};
@@ -28,8 +28,9 @@ pub const CG_ERROR_SHARE: f64 = 1e-4;
 
 /// How many times faster a flop of the supernodal factorization (dense kernels) runs than a flop
 /// of the sparse product with `A` (memory bound): a 50 x 50 cloth's factorization takes
-/// 4.4e8 flops in 21-26 ms, a product 1.0e6 flops in 0.17 ms (2-core dev VM, one thread).
-const FACTORIZATION_FLOP_SPEEDUP: f64 = 3.0;
+/// 4.24e8 flops in 21-26 ms, a conjugate gradient iteration 0.91e6 flops in about 0.2 ms
+/// (2-core dev VM, one thread): a break-even at 116 iterations.
+const FACTORIZATION_FLOP_SPEEDUP: f64 = 4.0;
 
 /// How the Newton system is solved.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
