@@ -152,6 +152,8 @@ pub struct Simulation {
     /// Per DOF, the inertia term of the Newton matrix's diagonal, `m/h² + α m/h` (fixed DOFs:
     /// 1, their whole diagonal).
     inertia: Vec<f64>,
+    /// The smallest inertia term of a free DOF, the bound on `λ_min` of the Newton matrix.
+    smallest_inertia: f64,
     /// The Cholesky factor's memory, kept from step to step once a step factors.
     cholesky: Option<CholeskyWorkspace>,
 }
@@ -186,9 +188,11 @@ impl Simulation {
         let pattern = HessianPattern::new(positions.len(), &model.element_vertices());
         let pinned = pattern.slots_touching(&fixed);
         let (h, alpha) = (dynamics.dt_s, dynamics.mass_damping);
-        let inertia = (0..fixed.len())
+        let inertia: Vec<f64> = (0..fixed.len())
             .map(|dof| if fixed[dof] { 1.0 } else { masses[dof / 3] * (1.0 / (h * h) + alpha / h) })
             .collect();
+        let smallest_inertia =
+            inertia.iter().zip(&fixed).filter(|(_, f)| !**f).fold(f64::INFINITY, |m, (c, _)| m.min(*c));
         Self {
             velocities: vec![Vector3::zeros(); positions.len()],
             positions,
@@ -204,6 +208,7 @@ impl Simulation {
             pattern,
             pinned,
             inertia,
+            smallest_inertia,
             cholesky: None,
             model,
         }
@@ -339,13 +344,7 @@ impl Simulation {
         within_cost: bool,
         solves: &mut LinearSolves,
     ) -> Option<Vec<f64>> {
-        let smallest_inertia = self
-            .inertia
-            .iter()
-            .zip(&self.fixed)
-            .filter(|(_, fixed)| !**fixed)
-            .fold(f64::INFINITY, |m, (c, _)| m.min(*c));
-        let tolerance = CG_ERROR_SHARE * self.dynamics.tolerance_m * smallest_inertia;
+        let tolerance = CG_ERROR_SHARE * self.dynamics.tolerance_m * self.smallest_inertia;
         let mut x = vec![0.0; b.len()];
         let b_norm = dot(b, b).sqrt();
         if b_norm <= tolerance {
