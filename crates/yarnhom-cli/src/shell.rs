@@ -66,11 +66,12 @@ pub struct SimulateArgs {
 /// [`LinearSolver`] on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum LinearSolverArg {
-    /// `auto`.
+    /// Conjugate gradients where their bound iteration count costs less than a factorization,
+    /// else Cholesky (the default).
     Auto,
-    /// `cholesky`.
+    /// Sparse Cholesky for every solve.
     Cholesky,
-    /// `conjugate-gradient`.
+    /// Conjugate gradients for every solve (Cholesky only where they fail).
     ConjugateGradient,
 }
 
@@ -87,9 +88,9 @@ impl From<LinearSolverArg> for LinearSolver {
 /// [`NewtonMatrix`] on the command line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum NewtonMatrixArg {
-    /// `projected`.
+    /// The exact element Hessians with their eigenvalues made absolute.
     Projected,
-    /// `gauss-newton`.
+    /// Gauss-Newton in the forms, positive semidefinite by construction (the default).
     GaussNewton,
 }
 
