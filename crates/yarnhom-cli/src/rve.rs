@@ -46,6 +46,25 @@ pub enum RveCommand {
     /// (for a Slurm job array or a Kubernetes Indexed Job: tools/slurm-sample.sh,
     /// tools/k8s-sample.yaml); `yarnhom grid merge` joins the shards bit-identically.
     Sample(crate::sample::SampleArgs),
+    /// Measure how far the pattern's stored state is from an equilibrium of the yarn model: the
+    /// forces of stretching, of bending and twisting, and of contact at the pattern's own
+    /// geometry (its periods, zero strain), projected on the solver's constraints, and the
+    /// contact scale that would balance them best.
+    ///
+    /// A published rest state is an equilibrium of the code that made it; a large residual
+    /// means the two models differ, and the contact scale says by how much their contact does.
+    /// (The published HYLC patterns, pooled, gave the factor between Table 4.1's `k_contact`
+    /// and this model's Kaldor integral.) Exit status 0, 2 on bad input.
+    Residual(ResidualArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ResidualArgs {
+    /// The pattern, with a rest state (`.yh`, JSON, HDF5 or `.pyp`).
+    pub pattern: PathBuf,
+    /// Yarn model: a built-in `table4.1:<row>` (see `yarnhom model list`) or a `yarnmodel` file.
+    #[arg(long)]
+    pub model: String,
 }
 
 #[derive(Debug, Args)]
@@ -112,6 +131,7 @@ pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
         RveCommand::Solve(args) => solve(args),
         RveCommand::Relax(args) => relax(args),
         RveCommand::Sample(args) => crate::sample::run(args),
+        RveCommand::Residual(args) => residual(args),
     }
 }
 
@@ -249,6 +269,27 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         eprintln!("error: the solve did not converge ({})", stop_reason(report.reason));
         Ok(Outcome::Different)
     }
+}
+
+fn residual(args: ResidualArgs) -> anyhow::Result<Outcome> {
+    let (pattern, model, _) = load_pattern_and_model(&args.pattern, &args.model)?;
+    let r = yarnhom_rve::residual::equilibrium_residual(&pattern, &model)?;
+    println!(
+        "forces at the stored state of '{}' under '{}' (projected on the constraints):",
+        pattern.name, model.name
+    );
+    println!("  stretching          {:.4e} N", r.stretch);
+    println!("  bending, twisting   {:.4e} N", r.bend_twist);
+    println!("  contact             {:.4e} N", r.contact);
+    println!("  total               {:.4e} N ({:.3} of the stretching force)", r.total, r.relative_at(1.0));
+    match r.best_contact_scale() {
+        Some(c) => println!(
+            "  best contact scale  {c:.3} (the contact that balances this state best), leaving {:.3} of the stretching force",
+            r.relative_at(c)
+        ),
+        None => println!("  no contact force: no yarns within reach of each other"),
+    }
+    Ok(Outcome::Success)
 }
 
 fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {

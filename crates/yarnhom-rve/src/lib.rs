@@ -18,6 +18,8 @@
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
 //! - [`homogenize`]: energy density and stress at a macro strain;
 //! - [`relax`]: rest states (Algorithm 2, Sec. 6.5.2);
+//! - [`residual`]: the forces left at a stored state (is a published rest state an equilibrium
+//!   of this model, and of which contact stiffness?);
 //! - [`sample`]: the sampling plan and parallel sweep engine of the energy database (App. A.3.1).
 
 pub mod assembly;
@@ -28,6 +30,7 @@ pub mod linear;
 pub mod model;
 pub mod placement;
 pub mod relax;
+pub mod residual;
 pub mod sample;
 pub mod solve;
 

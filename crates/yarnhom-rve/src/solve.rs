@@ -154,7 +154,7 @@ pub(crate) fn multipliers(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<
 }
 
 /// Gradient projected onto the tangent space of `C g = d` (A.31-A.32).
-fn projected(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
+pub(crate) fn projected(c: &DMatrix<f64>, gradient: &DVector<f64>) -> DVector<f64> {
     gradient - c.transpose() * multipliers(c, gradient)
 }
 

@@ -92,24 +92,34 @@ fn published_term(name: &str, k: usize, x: f64) -> f64 {
 
 #[test]
 fn stretch_response_matches_the_published_fits() {
-    // Energy added by stretching 30% along X1, ours (solve at sx=0.3 minus sx=0) against the
-    // published fit's 1D sx term: same ranking across patterns and each within 30%.
-    // (Measured: stock +22.5%, satin +12.7%, basket -11.9%, honey +8.7%.)
-    let names = ["stock", "satin", "basket", "honey"];
-    let mut ours = Vec::new();
+    // Energy added by stretching 30% along X1 and along X2, ours (solve at 0.3 minus 0)
+    // against the published fit's 1D sx and sy terms: each within the 25% of issue 3, and the
+    // same ranking across patterns along X1. (Measured: stock +0.0% / +1.3%, satin +0.5% /
+    // +0.5%, basket -19.2% / -17.8%, honey +1.8% / +3.7%, rib -5.3% / -3.2%; over 0.05..0.3,
+    // `examples/compare_published_fits.rs`.)
+    let names = ["stock", "satin", "basket", "honey", "rib"];
+    let mut along_x1 = Vec::new();
     for name in names {
         let t = tile(name);
-        let added = psi(&t, "sx=0.3") - psi(&t, "sx=0");
-        let published = published_term(name, 0, 0.3) - published_term(name, 0, 0.0);
-        println!(
-            "{name}: ours {added:.4}, published {published:.4} J/m², {:+.1}%",
-            100.0 * (added / published - 1.0)
-        );
-        assert!((added / published - 1.0).abs() < 0.3, "{name}: ours {added}, published {published}");
-        ours.push((added, published));
+        let rest = psi(&t, "sx=0");
+        for (k, axis) in [(0, "sx"), (2, "sy")] {
+            let added = psi(&t, &format!("{axis}=0.3")) - rest;
+            let published = published_term(name, k, 0.3) - published_term(name, k, 0.0);
+            println!(
+                "{name} {axis}: ours {added:.4}, published {published:.4} J/m², {:+.1}%",
+                100.0 * (added / published - 1.0)
+            );
+            assert!(
+                (added / published - 1.0).abs() < 0.25,
+                "{name} {axis}: ours {added}, published {published}"
+            );
+            if k == 0 {
+                along_x1.push((added, published));
+            }
+        }
     }
-    for w in ours.windows(2) {
-        assert!(w[0].0 > w[1].0 && w[0].1 > w[1].1, "ranking differs: {ours:?}");
+    for w in along_x1.windows(2) {
+        assert!(w[0].0 > w[1].0 && w[0].1 > w[1].1, "ranking differs: {along_x1:?}");
     }
 }
 
@@ -143,4 +153,37 @@ fn a_tile_bent_round_onto_itself_has_no_contact_wall() {
     for pair in steps.windows(2) {
         assert!(pair[1] > 0.0 && pair[1] < 1.5 * pair[0], "energy steps {steps:?}");
     }
+}
+
+#[test]
+fn the_published_rest_states_balance_the_normalized_kaldor_contact() {
+    // The published patterns are rest states of the thesis' code at their Table 4.1 rows. In
+    // this model their stretching, bending and contact forces should cancel; pooled over the
+    // four whose yarns touch, the best contact scale is within 10% of 1 (the normalization
+    // `KALDOR_TABLE_4_1_NORMALIZATION` is that estimate), and the normalization takes the
+    // stock, rib and honeycomb residuals below half of what Table 4.1's stiffness as our
+    // integral's leaves (measured: 0.095 / 0.24 / 0.12 of the stretching force against
+    // 0.67 / 0.74 / 0.82).
+    use yarnhom_rod::contact::KALDOR_TABLE_4_1_NORMALIZATION as NORMALIZATION;
+    use yarnhom_rve::residual::{equilibrium_residual, pooled_contact_scale};
+    let residuals: Vec<_> = ["stock", "rib", "honey", "satin"]
+        .into_iter()
+        .map(|name| {
+            let path =
+                format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
+            let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+            let pattern = parse_pyp(&text, name, None).expect("published pattern");
+            let residual =
+                equilibrium_residual(&pattern, &YarnModel::table_4_1(name).expect("row")).expect("tile");
+            let (ours, printed) = (residual.relative_at(1.0), residual.relative_at(1.0 / NORMALIZATION));
+            println!("{name}: {residual:?}; relative residual {ours:.3}, unnormalized {printed:.3}");
+            if name != "satin" {
+                assert!(ours < 0.5 * printed, "{name}: {ours} against {printed}");
+            }
+            residual
+        })
+        .collect();
+    let pooled = pooled_contact_scale(&residuals).expect("the yarns touch");
+    println!("pooled contact scale {pooled:.3}");
+    assert!((pooled - 1.0).abs() < 0.1, "pooled contact scale {pooled}");
 }
