@@ -4,9 +4,10 @@
 //! - [`ContactLaw::Kaldor`]: Kaldor et al. (2008), the contact of Ch. 3-5 whose stiffness is the
 //!   `k_contact` of Table 4.1: `φ = c_H k f(D / 2r)` with `f(d) = 1/d² + d² - 2` for `d < 1`,
 //!   else 0, and `c_H` = [`KALDOR_TABLE_4_1_NORMALIZATION`]. The thesis does not say how it
-//!   integrates this law; it is integrated with the 4 x 4 point Gauss-Legendre rule, which is
-//!   within 1% of the converged integral at grazing contact, where Simpson's 3 x 3 points
-//!   overestimate the force up to 1.7 times (see the constant's documentation);
+//!   integrates this law; it is integrated with the 4 x 4 point Gauss-Legendre rule, whose
+//!   forces summed over grazing edge pairs are within 1% of the converged integral's, where
+//!   Simpson's 3 x 3 points are 10% off (on the published stockinette's rest state they push
+//!   1.7 times harder than the converged integral);
 //! - [`ContactLaw::TwoPhase`]: (6.7), a soft outer and a stiff inner barrier,
 //!   `φ = Σ_i k_ci g(min(D / 2R_i, 1))²` with the IPC barrier `g(x) = -(x - 1)² ln x`
 //!   (Li et al. 2020). The square is as printed in (6.7), and so is the quadrature: Simpson's
@@ -44,7 +45,7 @@ pub enum ContactLaw {
 /// their Table 4.1 rows, so their yarns' forces balance there. With the stiffness as printed,
 /// they do not balance in this model: the contact pushes 1.6 times harder than stretching and
 /// bending can hold. The least-squares contact scale that balances them best
-/// (`yarnhom rve residual`, [`yarnhom-rve`'s `residual`]) is 0.602 for `stock`, 0.616 for
+/// (`yarnhom rve residual`, module `residual` of `yarnhom-rve`) is 0.602 for `stock`, 0.616 for
 /// `rib`, 0.670 for `honey` and 0.36 for `satin` (whose yarns barely touch); over the four
 /// together, weighted by their stretching forces, 0.637. The fitted bending scale stays at 1.0
 /// for `stock`, `honey` and `satin`, so only the contact differs. Independently, the energies

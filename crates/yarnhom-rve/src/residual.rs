@@ -4,7 +4,7 @@
 //! A published rest state (e.g. `hylc-patterns/*.pyp`) is an equilibrium of the code that made
 //! it. Evaluated in this model at its own periods and zero strain, its remaining force tells
 //! whether the two models agree: split by energy term, the generalized forces (gradient
-//! projected on the solver's constraints, [`crate::solve`]) of stretching `f_s`, bending and
+//! projected on the solver's constraints, [`mod@crate::solve`]) of stretching `f_s`, bending and
 //! twisting `f_b` and contact `f_c` should cancel. The contact scale `c` minimizing
 //! `|f_s + f_b + c f_c|` names how much harder or softer this model's contact is than the one
 //! the state balances. Pooled over patterns (weighted by their stretching forces), it is the
