@@ -37,7 +37,9 @@ pub enum YarnMechanics {
         shear_modulus_pa: f64,
         /// Multiplier gamma of the bending and twisting energies (3.25).
         gamma: f64,
-        /// Contact stiffness k_contact (kg/s^2).
+        /// Contact stiffness k_contact (kg/s^2) as Table 4.1 states it; the contact integral
+        /// applies 0.64 of it, the convention measured from the published rest states
+        /// (`yarnhom rve residual`).
         contact_stiffness_kg_s2: f64,
     },
     /// The Ch. 6 model: biphasic stretch (6.5), isotropic bending (6.6), two-phase contact (6.7).
