@@ -767,3 +767,24 @@ fn diff_of_an_old_schema_version_with_itself_and_its_migration_exits_0() {
     let o = yarnhom(&["diff", old, "new.rvesolve.yh"], d);
     assert_eq!(o.status.code(), Some(0), "{}{}", stdout(&o), stderr(&o));
 }
+
+#[test]
+fn rve_residual_finds_the_published_stockinette_balanced_by_the_table_4_1_contact() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let stock = format!("{DATA}/stock.pyp");
+    let text = ok(&["rve", "residual", &stock, "--model", "table4.1:stock"], dir.path());
+    let scale: f64 = text
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("best contact scale"))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no contact scale in: {text}"));
+    assert!((scale - 1.0).abs() < 0.1, "{text}");
+    let generated = dir.path().join("g.pattern.yh");
+    ok(&["pattern", "generate", "stockinette", "-o", generated.to_str().expect("utf8")], dir.path());
+    fails_with(
+        &["rve", "residual", generated.to_str().expect("utf8"), "--model", "table4.1:stock"],
+        dir.path(),
+        "has no rest state",
+    );
+}
