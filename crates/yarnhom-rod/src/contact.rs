@@ -132,6 +132,17 @@ impl ContactLaw {
 /// `rest_a`) and edge `b`; DOFs ordered `(xa0, xa1, xb0, xb1)`.
 pub fn contact_energy(
     law: &ContactLaw,
+    ends: [&Vector3<f64>; 4],
+    rest_a: f64,
+    rest_b: f64,
+) -> (f64, SVector<f64, 12>, SMatrix<f64, 12, 12>) {
+    integrate(law, law.quadrature(), ends, rest_a, rest_b)
+}
+
+/// [`contact_energy`] with the integral over both edges evaluated by `quadrature`.
+fn integrate(
+    law: &ContactLaw,
+    quadrature: &[(f64, f64)],
     [xa0, xa1, xb0, xb1]: [&Vector3<f64>; 4],
     rest_a: f64,
     rest_b: f64,
@@ -140,7 +151,6 @@ pub fn contact_energy(
     let mut energy = 0.0;
     let mut gradient = SVector::<f64, 12>::zeros();
     let mut hessian = SMatrix::<f64, 12, 12>::zeros();
-    let quadrature = law.quadrature();
     for &(sa, wa) in quadrature {
         for &(sb, wb) in quadrature {
             let v = xa0 * (1.0 - sa) + xa1 * sa - xb0 * (1.0 - sb) - xb1 * sb;
@@ -274,17 +284,7 @@ mod tests {
             });
             let ours = energy_of(&law, &q).1;
             let x = |k: usize| Vector3::new(q[3 * k], q[3 * k + 1], q[3 * k + 2]);
-            let simpson = SVector::<f64, 12>::from_fn(|i, _| {
-                let mut g = 0.0;
-                for &(sa, wa) in &SIMPSON {
-                    for &(sb, wb) in &SIMPSON {
-                        let v = x(0) * (1.0 - sa) + x(1) * sa - x(2) * (1.0 - sb) - x(3) * sb;
-                        let c = [1.0 - sa, sa, -(1.0 - sb), -sb][i / 3];
-                        g += wa * wb * c * law.density(v.norm()).1 * v[i % 3] / v.norm();
-                    }
-                }
-                g * rest.0 * rest.1
-            });
+            let simpson = integrate(&law, &SIMPSON, [&x(0), &x(1), &x(2), &x(3)], rest.0, rest.1).1;
             error2 += (ours - reference).norm_squared();
             simpson_error2 += (simpson - reference).norm_squared();
             norm2 += reference.norm_squared();
