@@ -1,6 +1,7 @@
 //! Wall time of one periodic tile solve (thesis Ch. 3) on the published patterns with their
-//! Table 4.1 yarn models, cold (affine start) and warm-started from the solution at a nearby
-//! strain (1% more stretch or curvature).
+//! Table 4.1 yarn models, cold (affine start), warm-started from the solution at a nearby
+//! strain (1% less stretch or curvature), and started by the secant predictor through the
+//! solutions at 1% and 2% less (`secant_start`, as the sampler does along its sweep lines).
 //! Compared with: thesis Table A.1, about 5.7 thread-seconds per sample for stockinette and 25
 //! for rib; yarnhom's target is under 0.2 s per cold stock solve on one core. Stock at sx=0.3 is
 //! also solved with additive CCD steps in place of the step limit.
@@ -8,7 +9,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::solve_at;
+use yarnhom_rve::homogenize::{secant_start, solve_at};
 use yarnhom_rve::{RveModel, SolveOptions, StepControl};
 
 fn tile(name: &str) -> RveModel {
@@ -23,20 +24,35 @@ fn bench_solves(c: &mut Criterion) {
     g.sample_size(10);
     for name in ["stock", "rib"] {
         let model = tile(name);
-        for (label, strain, nearby) in [("sx=0.3", "sx=0.3", "sx=0.303"), ("kx=40", "kx=40", "kx=40.4")] {
-            let strain: MacroStrain = strain.parse().expect("strain");
-            let nearby: MacroStrain = nearby.parse().expect("strain");
-            let (cold, solved) = solve_at(&model, &strain, None, &SolveOptions::default());
-            let (warm, _) = solve_at(&model, &nearby, Some(&solved), &SolveOptions::warm_started());
+        for (label, [before, last, strain]) in
+            [("sx=0.3", ["sx=0.294", "sx=0.297", "sx=0.3"]), ("kx=40", ["kx=39.2", "kx=39.6", "kx=40"])]
+        {
+            let [before, last, strain]: [MacroStrain; 3] =
+                [before, last, strain].map(|s| s.parse().expect("strain"));
+            let (cold, _) = solve_at(&model, &strain, None, &SolveOptions::default());
+            let (_, first) = solve_at(&model, &before, None, &SolveOptions::default());
+            let (_, nearby) = solve_at(&model, &last, Some(&first), &SolveOptions::warm_started());
+            let (warm, _) = solve_at(&model, &strain, Some(&nearby), &SolveOptions::warm_started());
+            let predict = || secant_start(&model, &strain, (&last, &nearby), (&before, &first));
+            let (predicted, _) = solve_at(&model, &strain, Some(&predict()), &SolveOptions::warm_started());
             eprintln!(
-                "{name} {label}: {} vertices, {} iterations cold, {} warm; converged {} {}",
-                model.vertices, cold.iterations, warm.iterations, cold.converged, warm.converged
+                "{name} {label}: {} vertices, {} iterations cold, {} warm, {} predicted; converged {} {} {}",
+                model.vertices,
+                cold.iterations,
+                warm.iterations,
+                predicted.iterations,
+                cold.converged,
+                warm.converged,
+                predicted.converged
             );
             g.bench_function(format!("{name} {label} cold"), |b| {
                 b.iter(|| solve_at(&model, &strain, None, &SolveOptions::default()))
             });
             g.bench_function(format!("{name} {label} warm"), |b| {
-                b.iter(|| solve_at(&model, &nearby, Some(&solved), &SolveOptions::warm_started()))
+                b.iter(|| solve_at(&model, &strain, Some(&nearby), &SolveOptions::warm_started()))
+            });
+            g.bench_function(format!("{name} {label} predicted"), |b| {
+                b.iter(|| solve_at(&model, &strain, Some(&predict()), &SolveOptions::warm_started()))
             });
         }
     }

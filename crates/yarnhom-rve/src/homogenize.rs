@@ -9,6 +9,7 @@ use crate::model::RveModel;
 use crate::placement::Placement;
 use crate::solve::{
     Iterate, SolveOptions, SolveReport, constraints, equilibrium_response, multipliers, solve_observed,
+    step_limit_m,
 };
 
 /// Central-difference steps of the solve-based stress: strain (dimensionless) and curvature (in
@@ -50,6 +51,44 @@ pub fn solve_at_observed(
     };
     let report = solve_observed(model, &placement, &mut state, options, observe);
     (report, state)
+}
+
+/// The start of a solve one step further along a sweep of strains: the secant predictor of a
+/// continuation. From the equilibria `last` and `before` it came through, the fluctuations and
+/// twists are extrapolated linearly to `strain`, `g = g_last + t (g_last - g_before)` with `t`
+/// the projection of `strain - last` on `last - before` (the step ratio along a line of samples).
+/// The extrapolation is shortened to the step limit of A.2.3, so it moves no vertex farther than
+/// one Newton step could, and is kept only where it lowers the energy at `strain` below that of
+/// the plain warm start from `last` (which is returned otherwise: after a snap-through the
+/// secant points the wrong way). Along the sweeps of the sampler this leaves about one Newton
+/// iteration per sample where a plain warm start needs two to four.
+pub fn secant_start(
+    model: &RveModel,
+    strain: &MacroStrain,
+    last: (&MacroStrain, &RveState),
+    before: (&MacroStrain, &RveState),
+) -> RveState {
+    let placement = placement(model, strain);
+    let mut warm = last.1.clone();
+    warm.update_frames(model, &placement);
+    let (target, a, b) = (strain_vector(strain), strain_vector(last.0), strain_vector(before.0));
+    let secant: [f64; 5] = std::array::from_fn(|k| a[k] - b[k]);
+    let length2: f64 = secant.iter().map(|d| d * d).sum();
+    if length2 == 0.0 {
+        return warm;
+    }
+    let t = (0..5).map(|k| (target[k] - a[k]) * secant[k]).sum::<f64>() / length2;
+    let mut delta = (&last.1.g - &before.1.g) * t;
+    let largest_move = (0..model.vertices).map(|v| delta.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+    let limit = step_limit_m(model, &placement);
+    if largest_move > limit {
+        delta *= limit / largest_move;
+    }
+    let mut predicted = last.1.clone();
+    predicted.g += delta;
+    predicted.update_frames(model, &placement);
+    let energy = |s: &RveState| assemble(model, &placement, s, &s.g, Want::Energy).energy_j;
+    if energy(&predicted) < energy(&warm) { predicted } else { warm }
 }
 
 /// Strain steps of the embedding derivative in [`stress_at_equilibrium`]: no solve is repeated,

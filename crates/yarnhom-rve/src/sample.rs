@@ -8,15 +8,19 @@
 //! compression.
 //!
 //! The samples are solved along [`SweepLine`]s walking outward from the origin, each solve
-//! warm-started from the previous one; lines are independent and run in parallel
+//! warm-started from the previous one (extrapolated along the line from the two before it,
+//! [`secant_start`]); lines are independent and run in parallel
 //! ([`sample_lines`]), and can be dealt to separate processes ([`shard_lines`]).
 
 use std::time::Instant;
 
 use rayon::prelude::*;
+use yarnhom_geom::MacroStrain;
 
 use crate::assembly::{RveState, world_positions};
-use crate::homogenize::{placement, solve_at, strain_from_vector, stress_at_equilibrium};
+use crate::homogenize::{
+    placement, secant_start, solve_at, strain_from_vector, strain_vector, stress_at_equilibrium,
+};
 use crate::model::RveModel;
 use crate::solve::{SolveOptions, StopReason};
 
@@ -377,8 +381,9 @@ pub struct SampleOutcome {
     pub index: [u32; 2],
     /// `(sx, sa, sy, kx, ky)`.
     pub strain: [f64; 5],
-    /// Whether the solve started from the previous sample's equilibrium (else from the affine
-    /// start: the line's first sample, or after a solve that did not converge).
+    /// Whether the solve started from the previous sample's equilibrium, possibly extrapolated
+    /// along the line ([`secant_start`]); else from the affine start: the line's first sample,
+    /// or after a solve that did not converge.
     pub warm_started: bool,
     /// Whether the equilibrium was found.
     pub converged: bool,
@@ -433,39 +438,53 @@ pub fn sample_lines(
     results
 }
 
-/// The samples of one line, in order.
+/// The samples of one line, in order: each warm-started from the previous converged one, by the
+/// secant predictor ([`secant_start`]) once two neighbouring samples have converged.
 fn sample_line(model: &RveModel, plan: &SamplePlan, line: &SweepLine, options: &SampleOptions) -> LineResult {
-    let mut previous: Option<RveState> = None;
+    // The line's last two converged equilibria, with their strains: the latest and the one
+    // before it.
+    let mut last: Option<(MacroStrain, RveState)> = None;
+    let mut before: Option<(MacroStrain, RveState)> = None;
     let samples = line
         .points
         .iter()
         .map(|&index| {
-            let (outcome, state) = sample_point(model, plan, line.term, index, previous.as_ref(), options);
-            previous = outcome.converged.then_some(state);
+            let values = plan.terms[line.term].strain(index);
+            let strain = strain_from_vector(values).expect("plan samples are valid strains");
+            let start = match (&last, &before) {
+                (Some((a, l)), Some((b, p))) => Some(secant_start(model, &strain, (a, l), (b, p))),
+                (Some((_, l)), None) => Some(l.clone()),
+                _ => None,
+            };
+            let (outcome, state) = sample_point(model, &strain, line.term, index, start.as_ref(), options);
+            if outcome.converged {
+                before = last.replace((strain, state));
+            } else {
+                (last, before) = (None, None);
+            }
             outcome
         })
         .collect();
     LineResult { line: line.index, samples }
 }
 
-/// Solve sample `index` of term `term`, from `start` if given, else from the affine start.
+/// Solve sample `index` of term `term` at `strain`, from `start` if given, else from the affine
+/// start.
 fn sample_point(
     model: &RveModel,
-    plan: &SamplePlan,
+    strain: &MacroStrain,
     term: usize,
     index: [usize; 2],
     start: Option<&RveState>,
     options: &SampleOptions,
 ) -> (SampleOutcome, RveState) {
     let started = Instant::now();
-    let values = plan.terms[term].strain(index);
-    let strain = strain_from_vector(values).expect("plan samples are valid strains");
     let base = if start.is_some() { SolveOptions::warm_started() } else { SolveOptions::default() };
     let solve_options = SolveOptions { max_iterations: options.max_iterations, ..base };
-    let (report, state) = solve_at(model, &strain, start, &solve_options);
-    let stress = (report.converged && options.stress).then(|| stress_at_equilibrium(model, &strain, &state));
+    let (report, state) = solve_at(model, strain, start, &solve_options);
+    let stress = (report.converged && options.stress).then(|| stress_at_equilibrium(model, strain, &state));
     let geometry = options.geometry.then(|| {
-        let positions = world_positions(model, &placement(model, &strain), &state);
+        let positions = world_positions(model, &placement(model, strain), &state);
         let twists = (0..model.vertices as u32).map(|v| state.g[model.twist_dof(v)]).collect();
         (positions, twists)
     });
@@ -473,7 +492,7 @@ fn sample_point(
     let outcome = SampleOutcome {
         term,
         index: index.map(|i| i as u32),
-        strain: values,
+        strain: strain_vector(strain),
         warm_started: start.is_some(),
         converged: report.converged,
         stop_reason: report.reason,

@@ -208,7 +208,7 @@ pub fn solve_observed(
     }
     let scale = DVector::from_fn(n, |i, _| if i < 3 * model.vertices { 1.0 } else { 1e6 * r });
     let c_scaled = &c * DMatrix::from_diagonal(&scale);
-    let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
+    let largest_step_m = step_limit_m(model, placement);
     let mut solver = SpdSolver::default();
     let residual = |gradient: &DVector<f64>| projected(&c, gradient).norm();
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
@@ -237,7 +237,7 @@ pub fn solve_observed(
                 StepControl::StepLimit => {
                     let largest_move =
                         (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
-                    if largest_move > p * r { p * r / largest_move } else { 1.0 }
+                    if largest_move > largest_step_m { largest_step_m / largest_move } else { 1.0 }
                 }
                 StepControl::AdditiveCcd { min_separation_radii } => {
                     max_collision_free_step(model, placement, state, &step, min_separation_radii * r)
@@ -277,6 +277,15 @@ pub fn solve_observed(
         constraint_residual: (&c * &state.g - &target).amax(),
         symbolic_analyses: solver.symbolic_analyses,
     }
+}
+
+/// The step limit of A.2.3: the largest distance a vertex may move in one Newton step,
+/// `p r` with `p = 0.05 + 0.15 λ_min` (`λ_min` the smallest eigenvalue of the macro strain's
+/// first fundamental form, clamped to `[0, 1]`), so that a step cannot carry a yarn through
+/// another.
+pub(crate) fn step_limit_m(model: &RveModel, placement: &Placement) -> f64 {
+    let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
+    p * model.radius_m
 }
 
 /// Allowance of the contact candidates of a solve, in yarn radii: the broad phase is rerun
