@@ -87,7 +87,9 @@ pub fn secant_start(
     let mut predicted = last.1.clone();
     predicted.g += delta;
     predicted.update_frames(model, &placement);
-    let energy = |s: &RveState| assemble(model, &placement, s, &s.g, Want::Energy).energy_j;
+    // One broad phase for both starts: the prediction moves no vertex farther than `limit`.
+    let candidates = ContactCandidates::new(model, &placement, &warm.g, limit);
+    let energy = |s: &RveState| assemble_with(model, &placement, s, &s.g, Want::Energy, &candidates).energy_j;
     if energy(&predicted) < energy(&warm) { predicted } else { warm }
 }
 
