@@ -2,9 +2,10 @@
 //!
 //! A fabric that is symmetric under `X1 -> -X1` (or `X2 -> -X2`) answers a shear `sa` and its
 //! opposite `-sa` alike (the reflection maps one onto the other and keeps `sx`, `sy`, `kx`, `ky`).
-//! The published stockinette tile is close to but not exactly such a fabric (it was relaxed with
-//! one vertex per yarn pinned, which breaks the symmetry), and its shear response is not
-//! symmetric either; the thesis symmetrizes the sampled energies for this reason (Sec. 4.1).
+//! The published stockinette tile is close to but not exactly such a fabric (as curves, 0.10 yarn
+//! radii RMS from its `X2 -> -X2` image, [`Mirror::centreline_distances_m`]), and its shear
+//! response is nearly but not exactly symmetric either; the thesis symmetrizes the sampled
+//! energies (Sec. 4.3.1).
 //! The mirror image of a tile, rest state included, is the tile's response to the mirrored
 //! strain: a test of the rod frames' conventions and of the solver's equivariance.
 //!
@@ -94,6 +95,63 @@ impl Mirror {
     pub fn max_distance_m(&self) -> f64 {
         self.residual_m.iter().map(|r| Vector3::from(*r).norm()).fold(0.0, f64::max)
     }
+
+    /// Distance of every vertex of `pattern` (the tile this mirror was found on) from the mirror
+    /// image of its partner yarn's centreline: the nearest point of the image polyline around its
+    /// source, with the mirror's translation refined for these distances (a translation-only
+    /// point-to-curve alignment) (m). Unlike [`Mirror::residual_m`] this compares shapes only:
+    /// two tiles whose yarns follow the same curves with vertices spaced differently along them
+    /// are 0 apart.
+    pub fn centreline_distances_m(&self, pattern: &Pattern) -> Vec<f64> {
+        let mut place = vec![(0, 0); pattern.vertex_count()];
+        for (y, yarn) in pattern.yarns.iter().enumerate() {
+            for (k, &v) in yarn.vertices.iter().enumerate() {
+                place[v as usize] = (y, k as i64);
+            }
+        }
+        let yarns: Vec<Unwrapped> = (0..pattern.yarns.len()).map(|y| Unwrapped::of(pattern, y)).collect();
+        // Each vertex minus its nearest point on the image centreline moved by `offset`.
+        let residuals = |offset: Vector3<f64>| -> Vec<Vector3<f64>> {
+            (0..pattern.vertex_count())
+                .map(|v| {
+                    let x = Vector3::from(pattern.positions_m[v]);
+                    let image_of_source = x - Vector3::from(self.residual_m[v]) + offset;
+                    let (partner, k) = place[self.source[v] as usize];
+                    let w = &yarns[partner];
+                    let image = |j: i64| image_of_source + self.axis.reflect(w.at(j) - w.at(k));
+                    (k - IMAGE_NEIGHBOURHOOD..k + IMAGE_NEIGHBOURHOOD)
+                        .map(|j| x - nearest_on_segment(x, image(j), image(j + 1)))
+                        .min_by(|a, b| a.norm_squared().total_cmp(&b.norm_squared()))
+                        .expect("a non-empty neighbourhood")
+                })
+                .collect()
+        };
+        let mut offset = Vector3::zeros();
+        for _ in 0..ALIGNMENT_ITERATIONS {
+            let step = mean(residuals(offset).into_iter());
+            offset += step;
+            if step.norm() < ALIGNMENT_TOLERANCE * pattern.radius_range_m().0 {
+                break;
+            }
+        }
+        residuals(offset).iter().map(Vector3::norm).collect()
+    }
+}
+
+/// Edges on either side of a vertex's source searched for the nearest point of the image
+/// centreline in [`Mirror::centreline_distances_m`].
+const IMAGE_NEIGHBOURHOOD: i64 = 3;
+
+/// Iteration limit and step tolerance (in yarn radii) of the translation refinement in
+/// [`Mirror::centreline_distances_m`].
+const ALIGNMENT_ITERATIONS: usize = 200;
+const ALIGNMENT_TOLERANCE: f64 = 1e-9;
+
+/// The point of the segment `a b` nearest `x`.
+fn nearest_on_segment(x: Vector3<f64>, a: Vector3<f64>, b: Vector3<f64>) -> Vector3<f64> {
+    let ab = b - a;
+    let t = ((x - a).dot(&ab) / ab.norm_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+    a + ab * t
 }
 
 /// One yarn's centreline unwrapped across tile boundaries, extended periodically.

@@ -209,7 +209,7 @@ fn the_published_stockinette_rests_unsheared_and_shears_nearly_symmetrically() {
     // Issue 3: "shear response is symmetric in sa for the published stock pattern". What the
     // thesis observed of its own yarn-level runs is "symmetric rest shapes with zero shear", and
     // it still symmetrized its sampled data in sa (Sec. 4.3.1, App. A.3.2): the published tile is
-    // the mirror image of itself (about its X1 axis, which turns sa into -sa) only to 0.09 yarn
+    // the mirror image of itself as curves (about its X1 axis, which turns sa into -sa) only to 0.10 yarn
     // radii RMS, 0.16 at most, and its contacts are grazing (centrelines 1.9-2 radii apart), so
     // they close at different |sa| on the two sides. Measured: the rest is the shear minimum
     // (Ψ(0.01) - Ψ(0) = 6.8e-5, Ψ(-0.01) - Ψ(0) = 1.1e-5 J/m²); the two sides differ by 6.3% RMS
