@@ -3,7 +3,7 @@
 //! artifact, so published materials run in our simulator and our fits run in theirs.
 //!
 //! The layout, as read by ARCSim-HYLC's `SplineMaterial`:
-//! - `density` (kg/m²), `strain scale` [5], `strain shift` = `[1, 0, 1, 0, 0]` (the in-plane
+//! - `density` (kg/m²), `strain scale` (5 numbers), `strain shift` = `[1, 0, 1, 0, 0]` (the in-plane
 //!   strains are stretch ratios minus 1);
 //! - `coeffs.const` = `f0`;
 //! - `coeffs.1D[]` = `{k, t, p, m}`: knots, values, slopes of term `k`;

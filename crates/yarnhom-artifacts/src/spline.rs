@@ -2,7 +2,7 @@
 //! (thesis Sec. 4.1, (4.2), (4.3), App. A.3, (A.34)).
 //!
 //! The energy density is `f0 + Σ f_i + Σ f_ij` over the strain parameters
-//! `(sx, sa, sy, kx, ky)` ([`AXIS_NAMES`](crate::grid::AXIS_NAMES)), each spline evaluated at the
+//! `(sx, sa, sy, kx, ky)` ([`crate::grid::AXIS_NAMES`]), each spline evaluated at the
 //! strain divided by [`Spline::strain_scale`]; the bending terms are evaluated on the principal
 //! curvatures and blended by (4.3). The same layout as the published ARCSim-HYLC JSON
 //! ([`crate::arcsim`]), so published materials and our fits are interchangeable.

@@ -3,7 +3,7 @@
 //!
 //! Every evaluation of the objective first estimates the yarns' rest shape for the candidate
 //! parameters (Sec. 6.5.2: rest-shape resets with rest lengths within 20% of the input geometry,
-//! [`yarnhom_rve::relax`]), then simulates the tile along every tested direction
+//! [`yarnhom_rve::relax()`]), then simulates the tile along every tested direction
 //! ([`crate::yarn_objective`]) and scores it by (6.11): rest shapes and mechanical parameters
 //! alternate, as the thesis prescribes. The global step is a particle swarm
 //! ([`crate::swarm`], 64 particles x 10 generations on 7 targets per direction); the local step

@@ -163,7 +163,7 @@ const COMPRESSION_LIMIT: f64 = 0.9;
 
 /// The compression of zero orthogonal stress at stretch `s` (Sec. 6.5.1), starting the search
 /// at `guess` from the equilibrium `start`: secant steps on `σ_c(c)` (at most
-/// [`MAX_COMPRESSION_STEP`] each), regula falsi once samples of both signs bracket the root
+/// `MAX_COMPRESSION_STEP` each), regula falsi once samples of both signs bracket the root
 /// (bisection where it would fall near the bracket's ends). Converged when `|σ_c|` is below 1% of the
 /// stretch stress (at least of 1 N/m) or the bracket is narrower than `1e-5`.
 pub fn zero_orthogonal_stress(

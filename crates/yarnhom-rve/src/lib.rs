@@ -17,7 +17,7 @@
 //! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
 //! - [`linear`]: sparse Cholesky with reused symbolic analysis;
 //! - [`homogenize`]: energy density and stress at a macro strain;
-//! - [`relax`]: rest states (Algorithm 2, Sec. 6.5.2);
+//! - [`mod@relax`]: rest states (Algorithm 2, Sec. 6.5.2);
 //! - [`residual`]: the forces left at a stored state (is a published rest state an equilibrium
 //!   of this model, and of which contact stiffness?);
 //! - [`sample`]: the sampling plan and parallel sweep engine of the energy database (App. A.3.1).

@@ -84,7 +84,8 @@ pub struct SampleRanges {
 }
 
 impl SampleRanges {
-    /// Validated ranges (see [`check_range`]).
+    /// Validated ranges: each finite with `lower < 0 < upper`, and `sx, sy > -1`, `|sa| < 1`
+    /// (4.1).
     pub fn new(lower: [f64; 5], upper: [f64; 5]) -> Result<Self, SampleError> {
         (0..5).try_for_each(|k| check_range(k, lower[k], upper[k]))?;
         Ok(SampleRanges { lower, upper })
@@ -164,7 +165,8 @@ impl PlanRanges {
 }
 
 impl Default for PlanRanges {
-    /// The published stockinette's ranges ([`SampleRanges::default`], [`STOCKINETTE_PLANES`]).
+    /// The published stockinette's ranges ([`SampleRanges::default`], and the planes' recovered
+    /// from `stock1.json`).
     fn default() -> Self {
         PlanRanges { single: SampleRanges::default(), planes: STOCKINETTE_PLANES.to_vec() }
     }

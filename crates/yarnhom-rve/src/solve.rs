@@ -19,7 +19,7 @@
 //! - convergence when the gradient projected on the constraints' tangent space falls below
 //!   `ε_z = 1e-5` of its value at the affine start (A.31-A.33; measured against the affine start
 //!   rather than the first iterate, so that a warm start is held to the same absolute accuracy,
-//!   and at least against the forces of a 0.1% stretch, see [`force_floor`]) and the constraints
+//!   and at least against the forces of a 0.1% stretch of every edge) and the constraints
 //!   hold to `ε_L r` (A.2.3).
 
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};

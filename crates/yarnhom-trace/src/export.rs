@@ -30,7 +30,7 @@
 //! earlier one; a later frame of the same name and number overwrites the file. Each file is
 //! written through a temporary file and renamed into place.
 //!
-//! # HDF5 ([`export_hdf5`], feature `hdf5`)
+//! # HDF5 (`export_hdf5`, feature `hdf5`)
 //!
 //! One group per stream; every frame of a stream has the same shape, so a stream's per-frame
 //! arrays stack into datasets whose first dimension is the frame (`F`, the number of messages of
