@@ -8,8 +8,8 @@ use crate::assembly::{ContactCandidates, RveState, Want, assemble, assemble_with
 use crate::model::RveModel;
 use crate::placement::Placement;
 use crate::solve::{
-    Iterate, SolveOptions, SolveReport, constraints, equilibrium_response, multipliers, solve_observed,
-    step_limit_m,
+    Iterate, SolveOptions, SolveReport, constraints, equilibrium_response, largest_vertex_move_m,
+    multipliers, solve_observed, step_limit_m,
 };
 
 /// Central-difference steps of the solve-based stress: strain (dimensionless) and curvature (in
@@ -79,7 +79,7 @@ pub fn secant_start(
     }
     let t = (0..5).map(|k| (target[k] - a[k]) * secant[k]).sum::<f64>() / length2;
     let mut delta = (&last.1.g - &before.1.g) * t;
-    let largest_move = (0..model.vertices).map(|v| delta.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+    let largest_move = largest_vertex_move_m(model, &delta);
     let limit = step_limit_m(model, &placement);
     if largest_move > limit {
         delta *= limit / largest_move;

@@ -235,8 +235,7 @@ pub fn solve_observed(
                 .component_mul(&scale);
             let mut length = match options.step_control {
                 StepControl::StepLimit => {
-                    let largest_move =
-                        (0..model.vertices).map(|v| step.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max);
+                    let largest_move = largest_vertex_move_m(model, &step);
                     if largest_move > largest_step_m { largest_step_m / largest_move } else { 1.0 }
                 }
                 StepControl::AdditiveCcd { min_separation_radii } => {
@@ -286,6 +285,11 @@ pub fn solve_observed(
 pub(crate) fn step_limit_m(model: &RveModel, placement: &Placement) -> f64 {
     let p = 0.05 + 0.15 * placement.smallest_stretch_eigenvalue().clamp(0.0, 1.0);
     p * model.radius_m
+}
+
+/// The largest distance a change `delta` of the DOFs moves a vertex (its twists aside).
+pub(crate) fn largest_vertex_move_m(model: &RveModel, delta: &DVector<f64>) -> f64 {
+    (0..model.vertices).map(|v| delta.fixed_rows::<3>(3 * v).norm()).fold(0.0, f64::max)
 }
 
 /// Allowance of the contact candidates of a solve, in yarn radii: the broad phase is rerun
