@@ -18,7 +18,7 @@ mod testing;
 pub mod vec3;
 
 pub use bend_twist::{BendTwist, BendTwistDofs, BendTwistReference, curvature_and_twist};
-pub use contact::{ContactLaw, contact_energy};
+pub use contact::{ContactLaw, contact_energy, contact_energy_only};
 pub use frames::EdgeFrame;
 pub use rod::{Rod, RodMaterial};
 pub use stretch::{StretchLaw, stretch_energy};

@@ -7,7 +7,8 @@ use nalgebra::{DVector, Matrix3, Vector3};
 use yarnhom_geom::segment_distance;
 use yarnhom_pattern::min_distance::lower_bound;
 use yarnhom_rod::{
-    BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, curvature_and_twist, stretch_energy,
+    BendTwistDofs, BendTwistReference, EdgeFrame, contact_energy, contact_energy_only, curvature_and_twist,
+    stretch_energy,
 };
 
 use crate::broadphase::{Aabb, EdgePair};
@@ -405,19 +406,16 @@ fn add_contacts(
         if lower_bound(&a0, &a1, &b0, &b1) >= reach {
             continue;
         }
-        let (e, grad, hess) = contact_energy(
-            &model.contact,
-            [&a0, &a1, &b0, &b1],
-            model.rest_length_m[a],
-            model.rest_length_m[b],
-        );
+        let (ends, rest) = ([&a0, &a1, &b0, &b1], (model.rest_length_m[a], model.rest_length_m[b]));
+        if want == Want::Energy {
+            out.energy_j += contact_energy_only(&model.contact, ends, rest.0, rest.1);
+            continue;
+        }
+        let (e, grad, hess) = contact_energy(&model.contact, ends, rest.0, rest.1);
         if e == 0.0 && grad.amax() == 0.0 {
             continue;
         }
         out.energy_j += e;
-        if want == Want::Energy {
-            continue;
-        }
         let h = want.hessian().then_some(hess.as_slice());
         let (sa, sb, o) = (model.stretch[a], model.stretch[b], model.images[image]);
         let instances = [sa.from, sa.to, shifted(sb.from, o), shifted(sb.to, o)];
