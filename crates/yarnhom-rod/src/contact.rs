@@ -139,8 +139,9 @@ pub fn contact_energy(
     integrate(law, law.quadrature(), ends, rest_a, rest_b)
 }
 
-/// The energy of [`contact_energy`] alone, without its derivatives (line searches, stresses by
-/// differences of energies): a tenth of the work where the pair is within reach.
+/// The energy of [`contact_energy`] alone, bit for bit, without its derivatives (for line
+/// searches and stresses by differences of energies, which would otherwise sum a 12 x 12
+/// Hessian at every node within reach).
 pub fn contact_energy_only(law: &ContactLaw, ends: [&Vector3<f64>; 4], rest_a: f64, rest_b: f64) -> f64 {
     let scale = rest_a * rest_b;
     nodes(law.quadrature(), ends).map(|(_, weight, v)| scale * weight * law.density(v.norm()).0).sum()

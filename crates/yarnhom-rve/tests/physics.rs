@@ -194,10 +194,9 @@ fn the_published_rest_states_balance_the_normalized_kaldor_contact() {
     assert!((pooled - 1.0).abs() < 0.1, "pooled contact scale {pooled}");
 }
 
-/// Energy added over the unstrained tile along a shear sweep `sa = ±0.01, ±0.02, .., ±0.25`
-/// (the sign `sign`), each solve warm-started from the one before, as the sampler walks a line.
-/// Energies added by shearing `model` from 0 to `sign · 0.01 · steps` in steps of 0.01, each solve
-/// warm-started from the one before, and the equilibrium at the last step.
+/// Energies added over the unstrained tile by shearing `model` from 0 to `sign · 0.01 · steps` in
+/// steps of 0.01, each solve warm-started from the one before as the sampler walks a line, and
+/// the equilibrium at the last step.
 fn shear_sweep(model: &RveModel, sign: f64, steps: usize) -> (Vec<f64>, RveState) {
     let zero: MacroStrain = "sx=0".parse().expect("strain");
     let (rest, mut state) = solve_at(model, &zero, None, &SolveOptions::default());
@@ -253,8 +252,9 @@ fn the_stockinettes_shear_asymmetry_is_its_tiles_and_not_the_sweeps() {
     // equilibrium at +0.1, mirrored. Started from those positions (the tile's own twists and
     // rest shape), the tile at -0.1 does not keep that low energy: it relaxes back to its own
     // -0.1 branch. Measured: Ψ - Ψ(0) is 2.68e-3 J/m² for Q, 4.05e-3 swept and 4.11e-3 from Q's
-    // positions (the same contact state; from 0.005 to 0.15 the start from Q's positions ends
-    // on the swept branch or on one between, never on Q's). So the asymmetry is the tile's.
+    // positions (the same contact state; at every |sa| from 0.005 to 0.15 the start from Q's
+    // positions ends on the swept branch or another, never as low as Q's where the two sides
+    // differ). So the asymmetry is the tile's.
     let pattern = published_pattern("stock");
     let yarn = YarnModel::table_4_1("stock").expect("Table 4.1 row");
     let image = mirrored(&pattern, &find_mirror(&pattern, MirrorAxis::X2).expect("a mirror")).expect("image");
