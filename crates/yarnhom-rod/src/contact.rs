@@ -143,21 +143,21 @@ pub fn contact_energy(
 /// searches and stresses by differences of energies, which would otherwise sum a 12 x 12
 /// Hessian at every node within reach).
 pub fn contact_energy_only(law: &ContactLaw, ends: [&Vector3<f64>; 4], rest_a: f64, rest_b: f64) -> f64 {
-    let scale = rest_a * rest_b;
-    nodes(law.quadrature(), ends).map(|(_, weight, v)| scale * weight * law.density(v.norm()).0).sum()
+    nodes(law.quadrature(), ends, rest_a * rest_b).map(|(_, w, v)| w * law.density(v.norm()).0).sum()
 }
 
 /// The nodes of `quadrature` over both edges: per node, the coefficients `c` of the point pair's
 /// difference `v = xa(sa) - xb(sb) = Σ c_k x_k`, `c = (1 - sa, sa, -(1 - sb), -sb)`, the node's
-/// weight and `v`.
+/// weight times `scale`, and `v`.
 fn nodes<'a>(
     quadrature: &'a [(f64, f64)],
     [xa0, xa1, xb0, xb1]: [&'a Vector3<f64>; 4],
+    scale: f64,
 ) -> impl Iterator<Item = ([f64; 4], f64, Vector3<f64>)> + 'a {
     quadrature.iter().flat_map(move |&(sa, wa)| {
         quadrature.iter().map(move |&(sb, wb)| {
             let c = [1.0 - sa, sa, -(1.0 - sb), -sb];
-            (c, wa * wb, xa0 * c[0] + xa1 * c[1] + xb0 * c[2] + xb1 * c[3])
+            (c, scale * wa * wb, xa0 * c[0] + xa1 * c[1] + xb0 * c[2] + xb1 * c[3])
         })
     })
 }
@@ -171,17 +171,15 @@ fn integrate(
     rest_a: f64,
     rest_b: f64,
 ) -> (f64, SVector<f64, 12>, SMatrix<f64, 12, 12>) {
-    let scale = rest_a * rest_b;
     let mut energy = 0.0;
     let mut gradient = SVector::<f64, 12>::zeros();
     let mut hessian = SMatrix::<f64, 12, 12>::zeros();
-    for (c, weight, v) in nodes(quadrature, ends) {
+    for (c, w, v) in nodes(quadrature, ends, rest_a * rest_b) {
         let distance = v.norm();
         let (phi, dphi, ddphi) = law.density(distance);
         if phi == 0.0 && dphi == 0.0 {
             continue;
         }
-        let w = scale * weight;
         let n = v / distance;
         let g_v = n * (w * dphi);
         let nn = n * n.transpose();
