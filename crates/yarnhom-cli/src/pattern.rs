@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::{AnyArtifact, Fabric, Pattern, container};
-use yarnhom_pattern::{GENERATORS, GeneratorParams, MirrorAxis, find_mirror, mirrored};
+use yarnhom_pattern::{GENERATORS, GeneratorParams, MirrorAxis, find_mirror, mirrored, root_mean_square};
 
 use crate::Outcome;
 use crate::inputs::{self, base_name, provenance};
@@ -214,7 +214,7 @@ fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
         mirror.max_distance_m() / r_lo
     );
     let curves = mirror.centreline_distances_m(&pattern);
-    let rms = (curves.iter().map(|d| d * d).sum::<f64>() / curves.len().max(1) as f64).sqrt();
+    let rms = root_mean_square(curves.iter().copied());
     let max = curves.iter().copied().fold(0.0, f64::max);
     println!(
         "  centrelines from their images (shapes only, vertex spacing aside): {:.4} mm RMS ({:.3} radii), {:.4} mm at most ({:.3} radii)",

@@ -17,7 +17,7 @@ use yarnhom_artifacts::{Fabric, Pattern, Yarn};
 
 use knit::Stitch::{self, Knit as K, Purl as P};
 pub use min_distance::{EdgeRef, MinDistance, YarnNeighbours, edge_clearances, min_inter_yarn_distance};
-pub use mirror::{Mirror, MirrorAxis, MirrorError, find_mirror, mirrored};
+pub use mirror::{Mirror, MirrorAxis, MirrorError, find_mirror, mirrored, root_mean_square};
 
 /// The smallest centreline distance between yarn pieces that a generated pattern keeps, in yarn
 /// radii (touching yarns are 2 radii apart; the published relaxed tiles come to 1.87-1.98).

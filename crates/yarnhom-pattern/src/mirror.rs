@@ -87,8 +87,7 @@ pub struct Mirror {
 impl Mirror {
     /// Root mean square distance of the vertices from their mirror images (m).
     pub fn rms_distance_m(&self) -> f64 {
-        let sum: f64 = self.residual_m.iter().map(|r| Vector3::from(*r).norm_squared()).sum();
-        (sum / self.residual_m.len().max(1) as f64).sqrt()
+        root_mean_square(self.residual_m.iter().map(|r| Vector3::from(*r).norm()))
     }
 
     /// Largest distance of a vertex from its mirror image (m).
@@ -273,6 +272,12 @@ fn matches_under_shift(
         }
     }
     Some((out, total))
+}
+
+/// Root mean square of `distances` (0 for none): of [`Mirror::centreline_distances_m`], say.
+pub fn root_mean_square(distances: impl ExactSizeIterator<Item = f64>) -> f64 {
+    let n = distances.len().max(1) as f64;
+    (distances.map(|d| d * d).sum::<f64>() / n).sqrt()
 }
 
 /// The mirror image about `axis` closest to the tile: every candidate for the first yarn fixes

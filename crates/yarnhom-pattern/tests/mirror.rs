@@ -1,7 +1,7 @@
 //! Mirror images and symmetrization of periodic tiles, on generated and published tiles.
 
 use yarnhom_artifacts::{Pattern, pyp::parse_pyp};
-use yarnhom_pattern::{GeneratorParams, MirrorAxis, find_mirror, generate, mirrored};
+use yarnhom_pattern::{GeneratorParams, MirrorAxis, find_mirror, generate, mirrored, root_mean_square};
 
 fn published(name: &str) -> Pattern {
     let path = format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));
@@ -77,7 +77,7 @@ fn every_published_tile_has_a_mirror_image_near_it() {
 }
 
 fn rms(d: &[f64]) -> f64 {
-    (d.iter().map(|x| x * x).sum::<f64>() / d.len() as f64).sqrt()
+    root_mean_square(d.iter().copied())
 }
 
 #[test]
