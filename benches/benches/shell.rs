@@ -16,7 +16,6 @@ use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
-use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::simulate::prepare;
@@ -31,7 +30,9 @@ type State = (Vec<Vector3<f64>>, Vec<Vector3<f64>>, f64);
 fn stock() -> ShellMaterial {
     let path = format!("{}/../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
     ShellMaterial::spline(SplineMaterial::from(
-        &read_spline(std::path::Path::new(&path)).expect("published material"),
+        &yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .map(|o| o.value)
+            .expect("published material"),
     ))
 }
 

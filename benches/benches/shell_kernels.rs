@@ -12,7 +12,6 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::{Vector2, Vector3};
-use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::split_hessian_18;
 use yarnhom_shell::forms::{RestTriangle, Stencil, forms_with_derivatives, forms_with_gradient};
@@ -26,7 +25,9 @@ fn deform(m: &Vector2<f64>) -> Vector3<f64> {
 
 fn bench_kernels(c: &mut Criterion) {
     let path = format!("{}/../../shared/data/hylc-materials/honey1.json", env!("CARGO_MANIFEST_DIR"));
-    let spline = read_spline(std::path::Path::new(&path)).expect("published material");
+    let spline = yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+        .map(|o| o.value)
+        .expect("published material");
     let mesh = ShellMesh::rectangle(0.02, 0.02, 5, 5).expect("mesh");
     let x: Vec<Vector3<f64>> = mesh.material.iter().map(deform).collect();
     let t = (0..mesh.triangles.len())

@@ -185,12 +185,12 @@ impl ArcsimMaterial {
     }
 }
 
-/// Read an ARCSim-HYLC material file into a validated [`Spline`] named after the file's stem.
-pub fn read_spline(path: &std::path::Path) -> Result<Spline> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::from(e).at(path))?;
+/// The ARCSim-HYLC material `text` of the file `path` as a validated [`Spline`] named after the
+/// file's stem (read files with [`crate::open::open_artifact`]).
+pub fn parse_spline(path: &std::path::Path, text: &str) -> Result<Spline> {
     let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("material");
     let file = path.file_name().and_then(|s| s.to_str()).unwrap_or(stem);
-    ArcsimMaterial::parse(&text).and_then(|m| m.to_spline(stem, file)).map_err(|e| e.at(path))
+    ArcsimMaterial::parse(text).and_then(|m| m.to_spline(stem, file))
 }
 
 /// Remove `//` line comments and `/* */` block comments outside strings (ARCSim's JSON
@@ -298,7 +298,8 @@ mod tests {
         for entry in std::fs::read_dir(&dir).expect("the published materials").flatten() {
             let path = entry.path();
             if path.extension().is_some_and(|e| e == "json") {
-                let spline = read_spline(&path).expect("published material imports");
+                let spline =
+                    crate::open::open_artifact::<Spline>(&path).expect("published material imports").value;
                 assert_eq!(spline.terms_1d.len(), 5, "{}", path.display());
                 assert_eq!(spline.terms_2d.len(), 9, "{}", path.display());
                 count += 1;

@@ -17,7 +17,7 @@
 //! the decompressed length, the content hash, the payload decode and finally the kind's own
 //! validation. Each failure is a distinct [`Error`] variant.
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
@@ -89,6 +89,19 @@ pub struct Provenance {
     pub producer: Producer,
     /// Inputs the artifact was made from.
     pub inputs: Vec<InputRef>,
+}
+
+impl Provenance {
+    /// What `yarnhom COMMAND` (this build) made from `inputs`.
+    pub fn of(command: &str, inputs: Vec<InputRef>) -> Self {
+        Provenance {
+            producer: Producer {
+                name: format!("yarnhom {command}"),
+                version: env!("CARGO_PKG_VERSION").into(),
+            },
+            inputs,
+        }
+    }
 }
 
 /// `sha256:<hex>` of some bytes.
@@ -286,43 +299,12 @@ pub fn read<T: Artifact>(path: impl AsRef<Path>) -> Result<(Header, T)> {
     decode(&bytes).map_err(|e| e.at(path))
 }
 
-/// Validate, encode and atomically write an artifact (temporary file in the same folder, then
-/// rename), so a reader never sees a half-written file. Returns the header written.
+/// Validate, encode and atomically write an artifact ([`crate::atomic`]), so a reader never sees
+/// a half-written file. Returns the header written.
 pub fn write<T: Artifact>(path: impl AsRef<Path>, value: &T, provenance: &Provenance) -> Result<Header> {
     let path = path.as_ref();
     let bytes = encode(value, provenance).map_err(|e| e.at(path))?;
     let (header, _) = decode_header(&bytes)?;
-    write_atomic(path, &bytes).map_err(|e| e.at(path))?;
+    crate::atomic::write_atomic(path, &bytes).map_err(|e| Error::from(e).at(path))?;
     Ok(header)
-}
-
-/// Write bytes to `path` atomically (see [`replace_atomically`]).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    replace_atomically(path, |_, file| Ok(file.write_all(bytes)?))
-}
-
-/// Replace `path` atomically with what `fill` writes into a temporary file beside it (given both
-/// as a path, for libraries that open files by name, and as an open file): the temporary file is
-/// synced, given the permissions of the file it replaces (or `0644`), then renamed over `path`.
-/// A reader never sees a half-written file; on error `path` is untouched and nothing is left.
-pub fn replace_atomically(
-    path: &Path,
-    fill: impl FnOnce(&Path, &mut std::fs::File) -> Result<()>,
-) -> Result<()> {
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new().prefix(".yarnhom-").suffix(".tmp").tempfile_in(dir)?;
-    let tmp_path = tmp.path().to_path_buf();
-    fill(&tmp_path, tmp.as_file_mut())?;
-    tmp.as_file().sync_all()?;
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let mode = std::fs::metadata(path).map_or(0o644, |m| m.permissions().mode());
-        tmp.as_file().set_permissions(std::fs::Permissions::from_mode(mode))?;
-    }
-    tmp.persist(path).map_err(|e| Error::Io(e.error))?;
-    Ok(())
 }

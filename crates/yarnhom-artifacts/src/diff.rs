@@ -257,6 +257,77 @@ pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
     }
 }
 
+/// Fields that differ from run to run and are not compared: wall-clock timings.
+pub const UNCOMPARED_FIELDS: &[&str] = &["wall_time_s"];
+
+/// Compare two JSON documents of `kind` (calibration reports): the same keys, array lengths,
+/// strings, booleans and nulls exactly; numbers within the tolerance, grouped by their path with
+/// array indices left out (`directions[].errors.force`), one field per group. The fields of
+/// [`UNCOMPARED_FIELDS`] are skipped (with a note).
+pub fn diff_documents(kind: &str, a: &serde_json::Value, b: &serde_json::Value, tol: Tolerance) -> Diff {
+    let mut walk = DocumentWalk { tol, diff: Diff::new(kind), groups: Vec::new(), skipped: false };
+    walk.compare("", a, b);
+    let DocumentWalk { mut diff, groups, skipped, .. } = walk;
+    diff.fields.extend(groups.into_iter().map(|(_, builder)| builder.finish()));
+    if skipped {
+        diff.notes.push(format!("not compared: {}", UNCOMPARED_FIELDS.join(", ")));
+    }
+    diff
+}
+
+/// The state of [`diff_documents`]: the differences so far, one numeric field per path.
+struct DocumentWalk {
+    tol: Tolerance,
+    diff: Diff,
+    groups: Vec<(String, FieldDiffBuilder)>,
+    skipped: bool,
+}
+
+impl DocumentWalk {
+    /// Compares the values at `path`.
+    fn compare(&mut self, path: &str, a: &serde_json::Value, b: &serde_json::Value) {
+        use serde_json::Value;
+        match (a, b) {
+            (Value::Object(x), Value::Object(y)) => {
+                let keys: std::collections::BTreeSet<&String> = x.keys().chain(y.keys()).collect();
+                for key in keys {
+                    let field = if path.is_empty() { key.clone() } else { format!("{path}.{key}") };
+                    match (x.get(key), y.get(key)) {
+                        _ if UNCOMPARED_FIELDS.contains(&key.as_str()) => self.skipped = true,
+                        (Some(u), Some(v)) => self.compare(&field, u, v),
+                        _ => self.diff.structural.push(format!("{field}: present in one document only")),
+                    }
+                }
+            }
+            (Value::Array(x), Value::Array(y)) if x.len() == y.len() => {
+                let field = format!("{path}[]");
+                x.iter().zip(y).for_each(|(u, v)| self.compare(&field, u, v));
+            }
+            (Value::Array(x), Value::Array(y)) => {
+                self.diff.structural.push(format!("{path}: {} vs {} entries", x.len(), y.len()));
+            }
+            (Value::Number(x), Value::Number(y)) => {
+                let (u, v, tol) = (x.as_f64().unwrap_or(f64::NAN), y.as_f64().unwrap_or(f64::NAN), self.tol);
+                self.number(path).push(&[u], &[v], tol);
+            }
+            _ if a == b => {}
+            _ => self.diff.structural.push(format!("{path}: {a} vs {b}")),
+        }
+    }
+
+    /// The numeric field of `path`, started on first use.
+    fn number(&mut self, path: &str) -> &mut FieldDiffBuilder {
+        let slot = match self.groups.iter().position(|(name, _)| name == path) {
+            Some(k) => k,
+            None => {
+                self.groups.push((path.to_string(), FieldDiffBuilder::new(path)));
+                self.groups.len() - 1
+            }
+        };
+        &mut self.groups[slot].1
+    }
+}
+
 /// Compare two patterns: topology exactly, then periods, vertices, twists, radii, rest state.
 pub fn diff_patterns(a: &Pattern, b: &Pattern, tol: Tolerance) -> Diff {
     let mut d = Diff::new("pattern");
@@ -459,4 +530,32 @@ fn matched_samples<'a>(a: &'a Grid, b: &'a Grid, d: &mut Diff) -> Vec<(&'a GridS
         }
     }
     pairs
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn documents_differ_in_numbers_beyond_tolerance_and_in_structure_but_not_in_timings() {
+        let tol = Tolerance { rtol: 1e-9, atol: 0.0 };
+        let a = serde_json::json!({"format": "yarnhom.x", "errors": [{"force": 0.1}, {"force": 0.2}], "wall_time_s": 3.0});
+        let same = serde_json::json!({"format": "yarnhom.x", "errors": [{"force": 0.1}, {"force": 0.2}], "wall_time_s": 9.0});
+        let d = diff_documents("x", &a, &same, tol);
+        assert!(d.equal(), "{}", d.report());
+        assert_eq!(d.fields.len(), 1);
+        assert_eq!((d.fields[0].field.as_str(), d.fields[0].count), ("errors[].force", 2));
+        assert_eq!(d.notes, ["not compared: wall_time_s"]);
+
+        let moved =
+            serde_json::json!({"format": "yarnhom.x", "errors": [{"force": 0.1}, {"force": 0.2000001}]});
+        let d = diff_documents("x", &a, &moved, tol);
+        assert!(!d.equal());
+        assert_eq!(d.fields[0].outside, 1);
+        assert!(diff_documents("x", &a, &moved, Tolerance { rtol: 1e-5, atol: 0.0 }).equal());
+
+        let renamed = serde_json::json!({"format": "yarnhom.y", "errors": [{"force": 0.1}]});
+        let d = diff_documents("x", &a, &renamed, tol);
+        assert_eq!(d.structural.len(), 2, "{:?}", d.structural);
+    }
 }

@@ -60,6 +60,26 @@ pub enum Error {
     /// The header names a kind this build does not know.
     #[error("unknown artifact kind '{0}' (known kinds: {known})", known = crate::KINDS.join(", "))]
     UnknownKind(String),
+    /// The file is none of the formats yarnhom reads.
+    #[error(
+        "not a yarnhom artifact (.yh, JSON document, HDF5 export), .pyp pattern, ARCSim-HYLC or Ch. 6 material, \
+         yarnhom report or MCAP trace"
+    )]
+    UnknownFormat,
+    /// The file holds something other than an artifact (a material file, a report, a trace).
+    #[error("holds a {found}, not an artifact")]
+    NotAnArtifact {
+        /// What it holds.
+        found: String,
+    },
+    /// A yarn model spec names no built-in model.
+    #[error("unknown yarn model '{name}' (known: {known})")]
+    UnknownYarnModel {
+        /// The spec given.
+        name: String,
+        /// The built-in models, comma-separated.
+        known: String,
+    },
     /// The file holds a different kind than the caller asked for.
     #[error("expected a '{expected}' artifact but the file holds '{found}'")]
     WrongKind {

@@ -92,9 +92,12 @@ use crate::container::{self, Header, InputRef, Producer};
 use crate::error::{Error, Result, ValidationError};
 use crate::grid::Grid;
 use crate::pattern::{Fabric, Pattern, RestState, Yarn};
-use crate::{AnyArtifact, Artifact};
+use crate::{AnyArtifact, Artifact, AtomicFile};
 
 mod grid;
+pub mod layer;
+
+use layer::{Spec, create_group, describe, h5, write_str_attr, write_u32_attr};
 
 const FORMAT: &str = "hdf5";
 
@@ -102,66 +105,76 @@ const FORMAT: &str = "hdf5";
 pub const KIND_ATTR: &str = "yarnhom_kind";
 
 /// A dataset of the layout: its path and the `units` and `description` attributes it carries.
-struct Spec {
+struct DatasetSpec {
     path: &'static str,
-    units: &'static str,
-    description: &'static str,
+    spec: Spec,
 }
 
-const PERIOD: Spec = Spec { path: "/period_m", units: "m", description: "tile periods along X1 and X2" };
-const POSITIONS: Spec = Spec {
+const PERIOD: DatasetSpec =
+    DatasetSpec { path: "/period_m", spec: Spec { units: "m", description: "tile periods along X1 and X2" } };
+const POSITIONS: DatasetSpec = DatasetSpec {
     path: "/positions_m",
-    units: "m",
-    description: "yarn centreline vertex positions in tile coordinates, one row per vertex",
+    spec: Spec {
+        units: "m",
+        description: "yarn centreline vertex positions in tile coordinates, one row per vertex",
+    },
 };
-const EDGE_TWIST: Spec = Spec {
+const EDGE_TWIST: DatasetSpec = DatasetSpec {
     path: "/edge_twist_rad",
-    units: "rad",
-    description: "twist of the material frame relative to the reference frame on the edge leaving each vertex",
+    spec: Spec {
+        units: "rad",
+        description: "twist of the material frame relative to the reference frame on the edge leaving each vertex",
+    },
 };
-const YARN_RADIUS: Spec = Spec { path: "/yarns/radius_m", units: "m", description: "radius of each yarn" };
-const YARN_START: Spec = Spec {
+const YARN_RADIUS: DatasetSpec =
+    DatasetSpec { path: "/yarns/radius_m", spec: Spec { units: "m", description: "radius of each yarn" } };
+const YARN_START: DatasetSpec = DatasetSpec {
     path: "/yarns/vertex_start",
-    units: "1",
-    description: "CSR row pointer: yarn y owns rows vertex_start[y]..vertex_start[y+1] of /yarns/vertices and /yarns/edge_offsets",
+    spec: Spec {
+        units: "1",
+        description: "CSR row pointer: yarn y owns rows vertex_start[y]..vertex_start[y+1] of /yarns/vertices and /yarns/edge_offsets",
+    },
 };
-const YARN_VERTICES: Spec = Spec {
+const YARN_VERTICES: DatasetSpec = DatasetSpec {
     path: "/yarns/vertices",
-    units: "1",
-    description: "vertex indices (rows of /positions_m) in order along each yarn; each yarn is closed periodically",
+    spec: Spec {
+        units: "1",
+        description: "vertex indices (rows of /positions_m) in order along each yarn; each yarn is closed periodically",
+    },
 };
-const YARN_OFFSETS: Spec = Spec {
+const YARN_OFFSETS: DatasetSpec = DatasetSpec {
     path: "/yarns/edge_offsets",
-    units: "1",
-    description: "whole tiles (along X1, X2) the end of each yarn edge is shifted by; the edge of row k joins vertices[k] to the next vertex of its yarn (cyclically)",
+    spec: Spec {
+        units: "1",
+        description: "whole tiles (along X1, X2) the end of each yarn edge is shifted by; the edge of row k joins vertices[k] to the next vertex of its yarn (cyclically)",
+    },
 };
-const REST_LENGTH: Spec = Spec {
+const REST_LENGTH: DatasetSpec = DatasetSpec {
     path: "/rest/edge_length_m",
-    units: "m",
-    description: "rest length of the edge leaving each vertex",
+    spec: Spec { units: "m", description: "rest length of the edge leaving each vertex" },
 };
-const REST_CURVATURE: Spec = Spec {
+const REST_CURVATURE: DatasetSpec = DatasetSpec {
     path: "/rest/vertex_curvature",
-    units: "1",
-    description: "rest material curvature (kappa1, kappa2) at each vertex, integrated (dimensionless)",
+    spec: Spec {
+        units: "1",
+        description: "rest material curvature (kappa1, kappa2) at each vertex, integrated (dimensionless)",
+    },
 };
-const REST_TWIST: Spec =
-    Spec { path: "/rest/vertex_twist_rad", units: "rad", description: "rest twist at each vertex" };
-const REST_DIRECTOR: Spec = Spec {
+const REST_TWIST: DatasetSpec = DatasetSpec {
+    path: "/rest/vertex_twist_rad",
+    spec: Spec { units: "rad", description: "rest twist at each vertex" },
+};
+const REST_DIRECTOR: DatasetSpec = DatasetSpec {
     path: "/rest/edge_reference_director",
-    units: "1",
-    description: "first director of the reference frame of the edge leaving each vertex (unit vector)",
+    spec: Spec {
+        units: "1",
+        description: "first director of the reference frame of the edge leaving each vertex (unit vector)",
+    },
 };
-const REST_REF_TWIST: Spec = Spec {
+const REST_REF_TWIST: DatasetSpec = DatasetSpec {
     path: "/rest/vertex_reference_twist_rad",
-    units: "rad",
-    description: "reference twist at each vertex",
+    spec: Spec { units: "rad", description: "reference twist at each vertex" },
 };
-
-/// An HDF5 library error, with what was being done.
-fn h5(context: impl std::fmt::Display, e: ::hdf5::Error) -> Error {
-    Error::Hdf5(format!("{context}: {e}"))
-}
 
 /// Write an artifact to an HDF5 file at `path`, atomically (see the [module docs](self) for the
 /// layout). `header` supplies the producer, creation time and inputs; the kind, schema version
@@ -210,15 +223,15 @@ fn export_as<T: Artifact>(
     let inputs = serde_json::to_string(&header.inputs)
         .map_err(|e| Error::Encode { what: "inputs", message: e.to_string() })?;
 
-    container::replace_atomically(path, |tmp, _| {
-        let file = File::with_options()
-            .with_fcpl(|fcpl| fcpl.obj_track_times(false))
-            .create(tmp)
-            .map_err(|e| h5("cannot create the HDF5 file", e))?;
-        write_header::<T>(&file, header, &content_hash, &inputs)?;
-        write(&file, artifact)?;
-        file.close().map_err(|e| h5("cannot close the HDF5 file", e))
-    })
+    let mut target = AtomicFile::create(path)?;
+    let file = File::with_options()
+        .with_fcpl(|fcpl| fcpl.obj_track_times(false))
+        .create(target.temp_path())
+        .map_err(|e| h5("cannot create the HDF5 file", e))?;
+    write_header::<T>(&file, header, &content_hash, &inputs)?;
+    write(&file, artifact)?;
+    file.close().map_err(|e| h5("cannot close the HDF5 file", e))?;
+    Ok(target.commit()?)
 }
 
 /// The root attributes of every export: kind, schema version, content hash, provenance.
@@ -270,45 +283,16 @@ fn write_pattern(root: &Group, p: &Pattern) -> Result<()> {
     Ok(())
 }
 
-fn create_group(root: &Group, name: &str) -> Result<()> {
-    root.create_group_builder()
-        .obj_track_times(false)
-        .create(name)
-        .map(drop)
-        .map_err(|e| h5(format_args!("cannot create group /{name}"), e))
-}
-
-fn write_dataset<T: H5Type>(root: &Group, spec: &Spec, shape: &[usize], data: &[T]) -> Result<()> {
+fn write_dataset<T: H5Type>(root: &Group, dataset: &DatasetSpec, shape: &[usize], data: &[T]) -> Result<()> {
     let ds = root
         .new_dataset_builder()
         .obj_track_times(false)
         .empty::<T>()
         .shape(shape)
-        .create(spec.path)
-        .map_err(|e| h5(format_args!("cannot create dataset {}", spec.path), e))?;
-    ds.write_raw(data).map_err(|e| h5(format_args!("cannot write dataset {}", spec.path), e))?;
-    write_str_attr(&ds, "units", spec.units)?;
-    write_str_attr(&ds, "description", spec.description)
-}
-
-/// A string as HDF5 variable-length UTF-8; `what` names it if it cannot be one.
-fn varlen(what: &str, value: &str) -> Result<VarLenUnicode> {
-    value.parse().map_err(|e| Error::Unrepresentable { format: FORMAT, message: format!("{what}: {e}") })
-}
-
-fn write_str_attr(loc: &Location, name: &str, value: &str) -> Result<()> {
-    let value = varlen(&format!("attribute '{name}'"), value)?;
-    loc.new_attr::<VarLenUnicode>()
-        .create(name)
-        .and_then(|a| a.write_scalar(&value))
-        .map_err(|e| h5(format_args!("cannot write attribute '{name}'"), e))
-}
-
-fn write_u32_attr(loc: &Location, name: &str, value: u32) -> Result<()> {
-    loc.new_attr::<u32>()
-        .create(name)
-        .and_then(|a| a.write_scalar(&value))
-        .map_err(|e| h5(format_args!("cannot write attribute '{name}'"), e))
+        .create(dataset.path)
+        .map_err(|e| h5(format_args!("cannot create dataset {}", dataset.path), e))?;
+    ds.write_raw(data).map_err(|e| h5(format_args!("cannot write dataset {}", dataset.path), e))?;
+    describe(&ds, &dataset.spec)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -507,7 +491,7 @@ fn exists(root: &Group, path: &str) -> bool {
 /// extent). Returns the row-major data and the shape.
 fn read_dataset<T: H5Type>(
     root: &Group,
-    spec: &Spec,
+    spec: &DatasetSpec,
     expected: &[Option<usize>],
 ) -> Result<(Vec<T>, Vec<usize>)> {
     if !exists(root, spec.path) {

@@ -5,10 +5,14 @@
 //! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`),
 //!   [`rvesolve::RveSolve`] (`rvesolve`), [`grid::Grid`] (`grid`), [`spline::Spline`] (`spline`).
 //! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
+//! - [`open`]: the one way to open an input, recognised by content.
+//! - [`membrane`]: the Ch. 6 shell material's parameters and its JSON file.
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
+//! - [`atomic`]: the one way yarnhom writes a file (temporary file, sync, rename, mode kept).
 
 pub mod arcsim;
+pub mod atomic;
 pub mod check;
 pub mod container;
 pub mod diff;
@@ -16,6 +20,8 @@ pub mod error;
 pub mod grid;
 #[cfg(feature = "hdf5")]
 pub mod hdf5;
+pub mod membrane;
+pub mod open;
 pub mod pattern;
 pub mod pyp;
 pub mod rvesolve;
@@ -25,6 +31,7 @@ pub mod yarnmodel;
 
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
 
+pub use atomic::{AtomicFile, write_atomic};
 pub use container::{Header, InputRef, Producer, Provenance, RawArtifact};
 pub use error::{Error, Result, ValidationError};
 pub use grid::{Grid, GridSample, GridShard, GridTerm, MergeError};
@@ -93,6 +100,19 @@ macro_rules! artifact_kinds {
                 $variant($ty),
             )+
         }
+
+        $(
+            impl TryFrom<AnyArtifact> for $ty {
+                type Error = AnyArtifact;
+                /// The artifact if it is of this kind, else the artifact back.
+                fn try_from(artifact: AnyArtifact) -> std::result::Result<Self, AnyArtifact> {
+                    match artifact {
+                        AnyArtifact::$variant(value) => Ok(value),
+                        other => Err(other),
+                    }
+                }
+            }
+        )+
 
         /// Every artifact kind this build knows.
         pub const KINDS: &[&str] = &[$(<$ty as Artifact>::KIND),+];

@@ -15,9 +15,9 @@
 use nalgebra::Vector3;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_rve::linear::SpdSolver;
 use yarnhom_shell::statics::StaticError;
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
+use yarnhom_sparse::SpdSolver;
 
 use crate::measure::{Direction, Face};
 use crate::strip::{Clamps, Strip};

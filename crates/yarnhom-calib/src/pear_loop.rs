@@ -20,9 +20,9 @@
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
-use yarnhom_rve::linear::SpdSolver;
 use yarnhom_shell::statics::StaticError;
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
+use yarnhom_sparse::SpdSolver;
 
 use crate::measure::Direction;
 use crate::strip::{Clamps, Strip};

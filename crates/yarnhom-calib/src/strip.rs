@@ -11,10 +11,10 @@
 //! both scale with it), so the tests simulate a narrow strip: [`STRIP_WIDTH_M`].
 
 use nalgebra::{Rotation2, Vector2, Vector3};
-use yarnhom_rve::linear::SpdSolver;
 use yarnhom_shell::elastic::ElasticModel;
 use yarnhom_shell::statics::{StaticError, StaticSettings, StaticStats, solve_static};
 use yarnhom_shell::{HingeBending, ShellMaterial, ShellMesh, StvkNeoHookean};
+use yarnhom_sparse::SpdSolver;
 
 use crate::measure::Direction;
 use crate::uniform::direction_angle;

@@ -13,11 +13,11 @@
 use nalgebra::{Rotation2, Vector2, Vector3};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_rve::linear::SpdSolver;
 use yarnhom_shell::elastic::{Assembly, ElasticModel};
 use yarnhom_shell::material::{FormsEnergy, ShellMaterial};
 use yarnhom_shell::statics::{StaticError, StaticSettings, solve_static};
 use yarnhom_shell::{ShellMesh, StvkNeoHookean};
+use yarnhom_sparse::SpdSolver;
 
 use crate::measure::{Direction, Specimen};
 use crate::uniform::direction_angle;

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use yarnhom_artifacts::{AnyArtifact, InputRef, Pattern, container};
+use yarnhom_artifacts::{InputRef, Pattern, Provenance, container};
 use yarnhom_calib::measure::MeasurementSet;
 use yarnhom_calib::shell_fit::{ShellFit, ShellFitSettings, fit_shell};
 use yarnhom_calib::swarm::SwarmSettings;
@@ -15,7 +15,6 @@ use yarnhom_calib::yarn_params::YarnBasis;
 
 use crate::Outcome;
 use crate::calibrate::{FITTED, Mark, Panel, Series, TARGET, plot_panels};
-use crate::inputs::{self, provenance};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum LocalArg {
@@ -155,12 +154,12 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
     container::write(
         args.output.join("yarn.yarnmodel.yh"),
         &fitted.model,
-        &provenance("calibrate yarn", from.clone()),
+        &Provenance::of("calibrate yarn", from.clone()),
     )?;
     container::write(
         args.output.join("rest.pattern.yh"),
         &fitted.rest_pattern,
-        &provenance("calibrate yarn", from),
+        &Provenance::of("calibrate yarn", from),
     )?;
     std::fs::write(args.output.join("yarn-fit.svg"), plot_yarn_fit(&fitted.fit)?)
         .with_context(|| format!("cannot write {}", args.output.join("yarn-fit.svg").display()))?;
@@ -188,11 +187,7 @@ pub(crate) fn set_basis(set: &MeasurementSet, pattern: &Pattern, yarn_stiffness:
 pub(crate) fn set_pattern(set_dir: &Path, spec: &str) -> Result<Pattern> {
     let candidates = [set_dir.join(spec), PathBuf::from(spec)];
     if let Some(path) = candidates.iter().find(|p| p.is_file()) {
-        let loaded = inputs::load(path, None)?;
-        return match loaded.artifact {
-            AnyArtifact::Pattern(p) => Ok(p),
-            other => anyhow::bail!("{}: holds a '{}', not a pattern", path.display(), other.kind()),
-        };
+        return Ok(yarnhom_artifacts::open::open_artifact::<Pattern>(path)?.value);
     }
     let params = yarnhom_pattern::GeneratorParams::defaults_for(spec).with_context(|| {
         format!("pattern '{spec}' of {}: neither a file nor a generator", set_dir.display())

@@ -3,20 +3,45 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use yarnhom_artifacts::{AnyArtifact, JsonDocument, Provenance, container};
+use yarnhom_artifacts::open::{base_name, open};
+use yarnhom_artifacts::{AnyArtifact, Header, JsonDocument, Provenance};
 
 use crate::Outcome;
-use crate::inputs::{self, Format, Loaded, base_name};
-use crate::pattern::write_text;
+use crate::output::{write_text, wrote};
+
+/// The formats `convert` writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum OutputFormat {
+    /// The native container (`NAME.KIND.yh`).
+    Yh,
+    /// JSON: `{"header": .., "payload": ..}`.
+    Json,
+    /// HDF5 (array-holding kinds), readable by h5py.
+    Hdf5,
+    /// The published HYLC periodic pattern text format (patterns only).
+    Pyp,
+}
+
+impl OutputFormat {
+    /// File extension for this format, given the artifact kind.
+    fn extension(self, kind: &str) -> String {
+        match self {
+            OutputFormat::Yh => format!("{kind}.yh"),
+            OutputFormat::Json => format!("{kind}.json"),
+            OutputFormat::Hdf5 => format!("{kind}.h5"),
+            OutputFormat::Pyp => "pyp".into(),
+        }
+    }
+}
 
 #[derive(Debug, Args)]
 pub struct ConvertArgs {
-    /// The input: a `.yh` artifact, a JSON document, an HDF5 export or a `.pyp` pattern
-    /// (recognised by content).
+    /// The input: a `.yh` artifact, a JSON document, an HDF5 export, a `.pyp` pattern or an
+    /// ARCSim-HYLC material (recognised by content).
     pub input: PathBuf,
     /// Output format. The conversion is lossless: converting back gives the same artifact.
     #[arg(long, value_enum)]
-    pub to: Format,
+    pub to: OutputFormat,
     /// Output file (default: the input's base name with the format's extension; `-` writes
     /// JSON or `.pyp` to standard output).
     #[arg(short, long)]
@@ -24,8 +49,8 @@ pub struct ConvertArgs {
 }
 
 pub fn run(args: ConvertArgs) -> anyhow::Result<Outcome> {
-    let loaded = inputs::load(&args.input, None)?;
-    let kind = loaded.artifact.kind();
+    let (header, artifact) = open(&args.input)?.into_artifact()?;
+    let kind = artifact.kind();
     let output = args
         .output
         .unwrap_or_else(|| format!("{}.{}", base_name(&args.input), args.to.extension(kind)).into());
@@ -35,41 +60,39 @@ pub fn run(args: ConvertArgs) -> anyhow::Result<Outcome> {
         output.display()
     );
     match args.to {
-        Format::Yh => write_yh(&output, &loaded)?,
-        Format::Json => {
-            let doc = JsonDocument { header: loaded.header.clone(), payload: loaded.artifact.to_json()? };
+        OutputFormat::Yh => write_yh(&output, &header, &artifact)?,
+        OutputFormat::Json => {
+            let doc = JsonDocument { header, payload: artifact.to_json()? };
             write_text(&output, &(serde_json::to_string_pretty(&doc)? + "\n"))?;
         }
-        Format::Pyp => {
-            let AnyArtifact::Pattern(p) = &loaded.artifact else {
+        OutputFormat::Pyp => {
+            let AnyArtifact::Pattern(p) = &artifact else {
                 anyhow::bail!("only patterns convert to .pyp; {} holds a '{kind}'", args.input.display())
             };
             write_text(&output, &yarnhom_artifacts::pyp::write_pyp(p)?)?;
         }
-        Format::Hdf5 => write_hdf5(&output, &loaded)?,
+        OutputFormat::Hdf5 => write_hdf5(&output, &header, &artifact)?,
     }
     Ok(Outcome::Success)
 }
 
 /// Re-encode keeping the original producer and inputs: a conversion changes no content.
-fn write_yh(output: &Path, loaded: &Loaded) -> anyhow::Result<()> {
-    let provenance =
-        Provenance { producer: loaded.header.producer.clone(), inputs: loaded.header.inputs.clone() };
-    let bytes = loaded.artifact.encode(&provenance)?;
-    container::write_atomic(output, &bytes).map_err(|e| e.at(output))?;
-    eprintln!("wrote {}", output.display());
+fn write_yh(output: &Path, header: &Header, artifact: &AnyArtifact) -> anyhow::Result<()> {
+    let provenance = Provenance { producer: header.producer.clone(), inputs: header.inputs.clone() };
+    crate::output::write_bytes(output, &artifact.encode(&provenance)?)?;
+    wrote(output);
     Ok(())
 }
 
 #[cfg(feature = "hdf5")]
-fn write_hdf5(output: &Path, loaded: &Loaded) -> anyhow::Result<()> {
+fn write_hdf5(output: &Path, header: &Header, artifact: &AnyArtifact) -> anyhow::Result<()> {
     anyhow::ensure!(output.as_os_str() != "-", "HDF5 cannot be written to standard output");
-    yarnhom_artifacts::hdf5::export(output, &loaded.header, &loaded.artifact).map_err(|e| e.at(output))?;
-    eprintln!("wrote {}", output.display());
+    yarnhom_artifacts::hdf5::export(output, header, artifact).map_err(|e| e.at(output))?;
+    wrote(output);
     Ok(())
 }
 
 #[cfg(not(feature = "hdf5"))]
-fn write_hdf5(_: &Path, _: &Loaded) -> anyhow::Result<()> {
+fn write_hdf5(_: &Path, _: &Header, _: &AnyArtifact) -> anyhow::Result<()> {
     anyhow::bail!("this yarnhom was built without the `hdf5` feature")
 }

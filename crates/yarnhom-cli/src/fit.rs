@@ -1,22 +1,24 @@
 //! `yarnhom fit ...`: homogenized cloth materials from sampled grids (thesis Sec. 4.1, App.
 //! A.3), and the ARCSim-HYLC material JSON in both directions.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::arcsim::{ArcsimMaterial, read_spline};
+use yarnhom_artifacts::arcsim::ArcsimMaterial;
 use yarnhom_artifacts::grid::AXIS_NAMES;
-use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, InputRef, Spline, container};
+use yarnhom_artifacts::open::{Format, Opened, open, open_artifact};
+use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, Spline};
 use yarnhom_fit::fit::restrict_grid;
 use yarnhom_fit::ranges::STOCKINETTE_SPAN_2D_BENDING;
 use yarnhom_fit::{
-    SplineMaterial, TermShape, fit_errors, fit_grid_with_regularized_terms, regularized_term_shapes,
-    term_shapes,
+    SplineMaterial, TermShape, compare_1d_terms, fit_errors, fit_grid_with_regularized_terms,
+    regularized_term_shapes, term_shapes,
 };
 
 use crate::Outcome;
-use crate::inputs::{self, provenance};
+use crate::args::{parse_axis, parse_interval};
+use crate::output::{write_artifact, write_bytes, wrote};
 
 /// `yarnhom fit GRID -o X.spline.yh`, or one of the subcommands.
 #[derive(Debug, Args)]
@@ -93,21 +95,6 @@ fn parse_limit(text: &str) -> Result<AxisLimit, String> {
     Ok(AxisLimit { axis: axis as u8, min, max })
 }
 
-/// The index of a strain parameter by its name (`sx`, `sa`, `sy`, `kx`, `ky`).
-pub(crate) fn parse_axis(name: &str) -> Result<usize, String> {
-    AXIS_NAMES
-        .iter()
-        .position(|&a| a == name.trim())
-        .ok_or_else(|| format!("unknown axis '{name}' (axes: {})", AXIS_NAMES.join(", ")))
-}
-
-/// `MIN:MAX` as two numbers.
-pub(crate) fn parse_interval(text: &str) -> Result<[f64; 2], String> {
-    let (min, max) = text.split_once(':').ok_or_else(|| format!("expected MIN:MAX, got '{text}'"))?;
-    let number = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("'{v}': {e}"));
-    Ok([number(min)?, number(max)?])
-}
-
 #[derive(Debug, Args)]
 pub struct ImportArgs {
     /// ARCSim-HYLC material JSON.
@@ -170,37 +157,11 @@ fn settings(args: &GridFitArgs) -> FitSettings {
     s
 }
 
-/// A grid artifact from a file, with its input reference.
-fn load_grid(path: &Path) -> anyhow::Result<(Grid, InputRef)> {
-    let loaded = inputs::load(path, None)?;
-    let input = InputRef {
-        kind: "grid".into(),
-        content_hash: loaded.header.content_hash.clone(),
-        path: path.display().to_string(),
-    };
-    match loaded.artifact {
-        AnyArtifact::Grid(grid) => Ok((grid, input)),
-        other => anyhow::bail!("{}: holds a '{}', not a grid", path.display(), other.kind()),
-    }
-}
-
-/// A spline from a `.spline.yh` (or its JSON/HDF5 forms) or an ARCSim-HYLC JSON.
-pub fn load_spline(path: &Path) -> anyhow::Result<Spline> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
-    if inputs::Format::sniff(&bytes).is_none() || bytes.windows(13).any(|w| w == b"\"strain scale") {
-        return Ok(read_spline(path)?);
-    }
-    match inputs::load(path, None)?.artifact {
-        AnyArtifact::Spline(spline) => Ok(spline),
-        other => anyhow::bail!("{}: holds a '{}', not a spline", path.display(), other.kind()),
-    }
-}
-
 fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
     let (Some(grid_path), Some(output)) = (&args.grid, &args.output) else {
         anyhow::bail!("usage: yarnhom fit GRID -o OUTPUT.spline.yh");
     };
-    let (grid, input) = load_grid(grid_path)?;
+    let Opened { value: grid, input, .. } = open_artifact::<Grid>(grid_path)?;
     if !grid.is_complete() {
         eprintln!(
             "warning: the grid holds {} of its plan's {} samples",
@@ -211,7 +172,7 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
     let fit = fit_grid_with_regularized_terms(&grid, &settings(&args), args.areal_density)
         .with_context(|| format!("cannot fit {}", grid_path.display()))?;
     let spline = fit.spline;
-    container::write(output, &spline, &provenance("fit", vec![input]))?;
+    write_artifact(output, &spline, "fit", vec![input])?;
     println!("{}", spline.summary());
     let fitted = restrict_grid(&grid, &args.limits);
     if !args.limits.is_empty() {
@@ -223,7 +184,7 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
     }
     print_errors(&fitted, &spline, !args.no_shear_symmetry);
     print_shapes(&fitted, &spline, &fit.regularized_2d);
-    println!("wrote {}", output.display());
+    wrote(output);
     Ok(Outcome::Success)
 }
 
@@ -272,80 +233,57 @@ fn shape_verdict(shape: &TermShape) -> String {
 }
 
 fn import(args: ImportArgs) -> anyhow::Result<Outcome> {
-    let spline = read_spline(&args.input)?;
-    container::write(&args.output, &spline, &provenance("fit import-arcsim", Vec::new()))?;
+    let input = open(&args.input)?;
+    anyhow::ensure!(input.format == Format::Arcsim, "{}: not an ARCSim-HYLC material", args.input.display());
+    let (_, artifact) = input.into_artifact()?;
+    let AnyArtifact::Spline(spline) = artifact else {
+        unreachable!("an ARCSim-HYLC material opens as a spline")
+    };
+    write_artifact(&args.output, &spline, "fit import-arcsim", Vec::new())?;
     println!("{}", spline.summary());
-    println!("wrote {}", args.output.display());
+    wrote(&args.output);
     Ok(Outcome::Success)
 }
 
 fn export(args: ExportArgs) -> anyhow::Result<Outcome> {
-    let spline = load_spline(&args.input)?;
+    let spline = open_artifact::<Spline>(&args.input)?.value;
     let json = ArcsimMaterial::from_spline(&spline).to_json()?;
-    std::fs::write(&args.output, json).with_context(|| format!("cannot write {}", args.output.display()))?;
-    println!("wrote {}", args.output.display());
+    write_bytes(&args.output, json.as_bytes())?;
+    wrote(&args.output);
     Ok(Outcome::Success)
 }
 
 fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
-    let (grid, _) = load_grid(&args.grid)?;
-    let spline = load_spline(&args.spline)?;
+    let grid = open_artifact::<Grid>(&args.grid)?.value;
+    let spline = open_artifact::<Spline>(&args.spline)?.value;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create {}", args.output.display()))?;
     for path in crate::fit_plot::plot_fit(&grid, &spline, &args.output)? {
-        println!("wrote {}", path.display());
+        wrote(&path);
     }
     Ok(Outcome::Success)
 }
 
-/// The strain range `[lo, hi]` a spline's 1D term has knots over (its fitted range).
-fn knot_range(spline: &Spline, axis: usize) -> Option<[f64; 2]> {
-    let term = spline.terms_1d.iter().find(|t| t.axis as usize == axis)?;
-    let scale = spline.strain_scale[axis];
-    Some([term.knots[0] * scale, term.knots[term.knots.len() - 1] * scale])
-}
-
-/// Two splines' 1D terms over the strains both were fitted on (the overlap of their knot
-/// ranges), each relative to its value at zero strain.
+/// Two splines' 1D terms over the strains both were fitted on.
 fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
-    let (a, b) = (load_spline(&args.first)?, load_spline(&args.second)?);
-    let (ma, mb) = (SplineMaterial::from(&a), SplineMaterial::from(&b));
+    let a = open_artifact::<Spline>(&args.first)?.value;
+    let b = open_artifact::<Spline>(&args.second)?.value;
     println!(
         "1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:",
         a.name, b.name
     );
     println!("  term  range                 RMS first  RMS second  RMS difference  shape correlation");
-    for axis in 0..5 {
-        let (Some(ra), Some(rb)) = (knot_range(&a, axis), knot_range(&b, axis)) else { continue };
-        let (lo, hi) = (ra[0].max(rb[0]), ra[1].min(rb[1]));
-        let xs: Vec<f64> = (0..=100).map(|k| lo + (hi - lo) * f64::from(k) / 100.0).collect();
-        let curve = |m: &SplineMaterial| -> Option<Vec<f64>> {
-            let zero = m.term_1d(axis, 0.0)?;
-            xs.iter().map(|&x| m.term_1d(axis, x).map(|v| v - zero)).collect()
-        };
-        let (Some(ca), Some(cb)) = (curve(&ma), curve(&mb)) else { continue };
-        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt();
-        let diff: Vec<f64> = ca.iter().zip(&cb).map(|(x, y)| x - y).collect();
+    for c in compare_1d_terms(&a, &b) {
         println!(
             "  {:4}  [{:8.3}, {:8.3}]  {:10.4e} {:11.4e} {:15.4e} {:18.3}",
-            yarnhom_artifacts::grid::AXIS_NAMES[axis],
-            lo,
-            hi,
-            rms(&ca),
-            rms(&cb),
-            rms(&diff),
-            correlation(&ca, &cb)
+            AXIS_NAMES[c.axis],
+            c.range[0],
+            c.range[1],
+            c.rms[0],
+            c.rms[1],
+            c.rms_difference,
+            c.shape_correlation
         );
     }
     Ok(Outcome::Success)
-}
-
-/// Pearson correlation of two curves: 1 for the same shape up to scale.
-fn correlation(a: &[f64], b: &[f64]) -> f64 {
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let (ma, mb) = (mean(a), mean(b));
-    let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-    let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-    let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-    cov / (va * vb).sqrt()
 }

@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::grid::Grid;
-use yarnhom_artifacts::{AnyArtifact, InputRef, container};
+use yarnhom_artifacts::open::open_artifact;
 
 use crate::Outcome;
-use crate::inputs::{self, provenance};
+use crate::output::{write_artifact, wrote};
 
 #[derive(Debug, Subcommand)]
 pub enum GridCommand {
@@ -34,22 +34,14 @@ pub fn run(cmd: GridCommand) -> anyhow::Result<Outcome> {
 }
 
 fn merge(args: MergeArgs) -> anyhow::Result<Outcome> {
-    let mut parts = Vec::new();
-    let mut sources = Vec::new();
+    let (mut parts, mut sources) = (Vec::new(), Vec::new());
     for path in &args.shards {
-        let loaded = inputs::load(path, None)?;
-        sources.push(InputRef {
-            kind: "grid".into(),
-            content_hash: loaded.header.content_hash.clone(),
-            path: path.display().to_string(),
-        });
-        match loaded.artifact {
-            AnyArtifact::Grid(grid) => parts.push(grid),
-            other => anyhow::bail!("{}: holds a '{}', not a grid", path.display(), other.kind()),
-        }
+        let shard = open_artifact::<Grid>(path)?;
+        parts.push(shard.value);
+        sources.push(shard.input);
     }
     let merged = Grid::merge(parts)?;
-    container::write(&args.output, &merged, &provenance("grid merge", sources))?;
+    write_artifact(&args.output, &merged, "grid merge", sources)?;
     if !merged.is_complete() {
         eprintln!(
             "warning: the merged grid holds {} of the plan's {} samples (shards missing?)",
@@ -58,6 +50,6 @@ fn merge(args: MergeArgs) -> anyhow::Result<Outcome> {
         );
     }
     println!("{}", merged.summary());
-    eprintln!("wrote {}", args.output.display());
+    wrote(&args.output);
     Ok(Outcome::Success)
 }

@@ -4,6 +4,7 @@
 //! crates together; it holds no numerics. Exit status: 0 success (and "equal" for `diff`),
 //! 1 "different" for `diff`, 2 any error (bad input, unreadable file, usage).
 
+mod args;
 mod calibrate;
 mod calibrate_yarn;
 mod convert;
@@ -11,10 +12,10 @@ mod diff;
 mod fit;
 mod fit_plot;
 mod grid;
-mod inputs;
 mod inspect;
 mod measure;
 mod model;
+mod output;
 mod pattern;
 #[cfg(feature = "rerun")]
 mod rerun_cmd;
@@ -24,7 +25,6 @@ mod schema;
 mod shell;
 mod trace;
 mod trace_export;
-mod trace_out;
 
 use std::process::ExitCode;
 
@@ -160,4 +160,23 @@ fn quiet_on_closed_stdout() {
         }
         default_hook(info);
     }));
+}
+
+#[cfg(test)]
+mod tests {
+    /// `docs/cli.md`, the full command reference, is generated from the clap definitions;
+    /// `YARNHOM_WRITE_CLI_DOCS=1 cargo test -p yarnhom-cli --bin yarnhom` rewrites it.
+    #[test]
+    fn the_command_reference_is_current() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/cli.md");
+        let generated = clap_markdown::help_markdown::<super::Cli>();
+        if std::env::var_os("YARNHOM_WRITE_CLI_DOCS").is_some() {
+            std::fs::write(path, &generated).expect("writes docs/cli.md");
+        }
+        let committed = std::fs::read_to_string(path).unwrap_or_default();
+        assert!(
+            committed == generated,
+            "docs/cli.md is stale: regenerate it with `YARNHOM_WRITE_CLI_DOCS=1 cargo test -p yarnhom-cli --bin yarnhom`"
+        );
+    }
 }

@@ -1,14 +1,14 @@
 //! `yarnhom pattern ...`: generators and `.pyp` interop.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::{AnyArtifact, Fabric, Pattern, container};
-use yarnhom_pattern::{GENERATORS, GeneratorParams, MirrorAxis, find_mirror, mirrored, root_mean_square};
+use yarnhom_artifacts::open::{Format, base_name, open_artifact, open_pattern_as};
+use yarnhom_artifacts::{AnyArtifact, Fabric, InputRef, Pattern};
+use yarnhom_pattern::{GENERATORS, GeneratorParams, MirrorAxis, find_mirror, mirrored};
 
 use crate::Outcome;
-use crate::inputs::{self, base_name, provenance};
+use crate::output::{write_artifact, write_text};
 
 #[derive(Debug, Subcommand)]
 pub enum PatternCommand {
@@ -141,101 +141,60 @@ fn list() -> anyhow::Result<()> {
 
 fn generate(args: GenerateArgs) -> anyhow::Result<()> {
     let mut params = GeneratorParams::defaults_for(&args.name)?;
-    if let Some(v) = args.stitch_width_m {
-        params.stitch_width_m = v;
-    }
-    if let Some(v) = args.stitch_height_m {
-        params.stitch_height_m = v;
-    }
-    if let Some(v) = args.radius_m {
-        params.yarn_radius_m = v;
-    }
-    if let Some(v) = args.vertices_per_stitch {
-        params.vertices_per_stitch = v;
-    }
+    params.stitch_width_m = args.stitch_width_m.unwrap_or(params.stitch_width_m);
+    params.stitch_height_m = args.stitch_height_m.unwrap_or(params.stitch_height_m);
+    params.yarn_radius_m = args.radius_m.unwrap_or(params.yarn_radius_m);
+    params.vertices_per_stitch = args.vertices_per_stitch.unwrap_or(params.vertices_per_stitch);
     let pattern = yarnhom_pattern::generate(&args.name, &params)?;
     eprintln!("{}", pattern.origin);
     let output = args.output.unwrap_or_else(|| format!("{}.pattern.yh", args.name).into());
-    write_pattern(&output, &pattern, provenance("pattern generate", vec![]))
+    write_pattern(&output, &pattern, "pattern generate", vec![])
 }
 
 fn import(args: ImportArgs) -> anyhow::Result<()> {
-    let loaded = inputs::load(&args.input, args.fabric.map(Fabric::from))?;
-    anyhow::ensure!(loaded.format == inputs::Format::Pyp, "{}: not a .pyp file", args.input.display());
-    let AnyArtifact::Pattern(mut pattern) = loaded.artifact else {
+    let input = open_pattern_as(&args.input, args.fabric.map(Fabric::from))?;
+    anyhow::ensure!(input.format == Format::Pyp, "{}: not a .pyp file", args.input.display());
+    let (header, artifact) = input.into_artifact()?;
+    let AnyArtifact::Pattern(mut pattern) = artifact else {
         anyhow::bail!("{}: not a pattern", args.input.display())
     };
     if let Some(name) = args.name {
         pattern.name = name;
     }
     let output = args.output.unwrap_or_else(|| format!("{}.pattern.yh", pattern.name).into());
-    write_pattern(&output, &pattern, provenance("pattern import", loaded.header.inputs))
+    write_pattern(&output, &pattern, "pattern import", header.inputs)
 }
 
 fn export(args: ExportArgs) -> anyhow::Result<()> {
-    let loaded = inputs::load(&args.input, None)?;
-    let AnyArtifact::Pattern(pattern) = &loaded.artifact else {
-        anyhow::bail!(
-            "{}: holds a '{}', only patterns export to .pyp",
-            args.input.display(),
-            loaded.artifact.kind()
-        )
-    };
-    let text = yarnhom_artifacts::pyp::write_pyp(pattern)?;
+    let pattern = open_artifact::<Pattern>(&args.input)?.value;
+    let text = yarnhom_artifacts::pyp::write_pyp(&pattern)?;
     let output = args.output.unwrap_or_else(|| format!("{}.pyp", base_name(&args.input)).into());
     write_text(&output, &text)
 }
 
 fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
-    let (pattern, input) = inputs::load_pattern(&args.input)?;
+    let opened = open_artifact::<Pattern>(&args.input)?;
+    let pattern = &opened.value;
     let axis = match args.axis {
         AxisArg::X1 => MirrorAxis::X1,
         AxisArg::X2 => MirrorAxis::X2,
     };
-    let mirror = find_mirror(&pattern, axis)?;
-    let (r_lo, _) = pattern.radius_range_m();
-    println!(
-        "mirror {axis} of {} ({} yarn(s), {} vertices)",
-        pattern.name,
-        pattern.yarns.len(),
-        pattern.vertex_count()
-    );
-    for (y, (partner, reversed)) in mirror.partner.iter().zip(&mirror.reversed).enumerate() {
-        let way = if *reversed { "backwards" } else { "forwards" };
-        println!("  yarn {y} <- yarn {partner}, {way}");
-    }
-    let t = mirror.shift_m;
-    println!("  translation ({:.4}, {:.4}, {:.4}) mm", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3);
-    println!(
-        "  vertices from their images: {:.4} mm RMS ({:.3} radii), {:.4} mm at most ({:.3} radii)",
-        mirror.rms_distance_m() * 1e3,
-        mirror.rms_distance_m() / r_lo,
-        mirror.max_distance_m() * 1e3,
-        mirror.max_distance_m() / r_lo
-    );
-    let curves = mirror.centreline_distances_m(&pattern);
-    let rms = root_mean_square(curves.iter().copied());
-    let max = curves.iter().copied().fold(0.0, f64::max);
-    println!(
-        "  centrelines from their images (shapes only, vertex spacing aside): {:.4} mm RMS ({:.3} radii), {:.4} mm at most ({:.3} radii)",
-        rms * 1e3,
-        rms / r_lo,
-        max * 1e3,
-        max / r_lo
-    );
+    let mirror = find_mirror(pattern, axis)?;
+    println!("{}", mirror.report(pattern));
     if let Some(output) = args.output {
-        let image = mirrored(&pattern, &mirror)?;
-        write_pattern(&output, &image, provenance("pattern mirror", vec![input]))?;
+        let image = mirrored(pattern, &mirror)?;
+        write_pattern(&output, &image, "pattern mirror", vec![opened.input])?;
     }
     Ok(())
 }
 
 fn write_pattern(
-    output: &PathBuf,
+    output: &Path,
     pattern: &Pattern,
-    provenance: yarnhom_artifacts::Provenance,
+    command: &str,
+    inputs: Vec<InputRef>,
 ) -> anyhow::Result<()> {
-    container::write(output, pattern, &provenance)?;
+    write_artifact(output, pattern, command, inputs)?;
     eprintln!(
         "wrote {} ({} yarn(s), {} vertices, {:.3} x {:.3} mm)",
         output.display(),
@@ -244,17 +203,5 @@ fn write_pattern(
         pattern.period_m[0] * 1e3,
         pattern.period_m[1] * 1e3
     );
-    Ok(())
-}
-
-/// Write text to a file atomically, or to standard output for `-`.
-pub fn write_text(output: &PathBuf, text: &str) -> anyhow::Result<()> {
-    if output.as_os_str() == "-" {
-        use std::io::Write;
-        std::io::stdout().write_all(text.as_bytes()).context("cannot write to standard output")?;
-    } else {
-        container::write_atomic(output, text.as_bytes()).map_err(|e| e.at(output))?;
-        eprintln!("wrote {}", output.display());
-    }
     Ok(())
 }

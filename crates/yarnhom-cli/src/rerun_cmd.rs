@@ -5,11 +5,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use yarnhom_rerun::{log_trace, rerun::RecordingStreamBuilder};
 use yarnhom_trace::TraceReader;
-use yarnhom_trace::rerun_log::{log_trace, rerun::RecordingStreamBuilder};
 
 use crate::Outcome;
-use crate::trace::open_source;
+use yarnhom_trace::open_source;
 
 #[derive(Debug, Args)]
 #[command(group(clap::ArgGroup::new("sink").required(true).args(["save", "stdout"])))]

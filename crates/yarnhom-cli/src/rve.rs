@@ -1,20 +1,21 @@
 //! `yarnhom rve ...`: the periodic yarn tile (thesis Ch. 3).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::{AnyArtifact, RveSolve, StrainSample, YarnModel, container};
+use yarnhom_artifacts::open::{base_name, open_artifact, open_yarn_model};
+use yarnhom_artifacts::{InputRef, Pattern, YarnModel};
 use yarnhom_geom::MacroStrain;
-use yarnhom_rve::homogenize::{solve_at_observed, stress_at_equilibrium, stress_by_finite_differences};
+use yarnhom_rve::homogenize::{Outputs, solve_to_artifact};
+use yarnhom_rve::messages::{iteration_message, yarn_frame};
 use yarnhom_rve::relax::RelaxEvent;
-use yarnhom_rve::{Iterate, RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl, StopReason};
-use yarnhom_trace::{SolverIteration, TraceMetadata};
+use yarnhom_rve::{Iterate, RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl};
+use yarnhom_trace::TraceMetadata;
 
 use crate::Outcome;
-use crate::inputs::{self, base_name, provenance};
-use crate::trace_out::{TraceSink, is_stdout, yarn_frame};
+use crate::output::{finish_trace, open_trace, print_summary, write_artifact, wrote};
 
 #[derive(Debug, Subcommand)]
 pub enum RveCommand {
@@ -135,56 +136,36 @@ pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
     }
 }
 
-/// A built-in `table4.1:<row>` model or a `yarnmodel` file.
-fn load_model(spec: &str) -> anyhow::Result<(YarnModel, Option<yarnhom_artifacts::InputRef>)> {
-    if let Some(row) = spec.strip_prefix("table4.1:") {
-        return Ok((crate::model::builtin(row)?, None));
-    }
-    let loaded = inputs::load(std::path::Path::new(spec), None)?;
-    let input = yarnhom_artifacts::InputRef {
-        kind: "yarnmodel".into(),
-        content_hash: loaded.header.content_hash.clone(),
-        path: spec.into(),
-    };
-    match loaded.artifact {
-        AnyArtifact::YarnModel(m) => Ok((m, Some(input))),
-        other => anyhow::bail!("{spec}: holds a '{}', not a yarnmodel", other.kind()),
-    }
-}
-
 /// The pattern and yarn model a tile command works on, and the inputs they name in provenance.
-pub(crate) fn load_pattern_and_model(
-    path: &std::path::Path,
+pub(crate) fn open_pattern_and_model(
+    path: &Path,
     model_spec: &str,
-) -> anyhow::Result<(yarnhom_artifacts::Pattern, YarnModel, Vec<yarnhom_artifacts::InputRef>)> {
-    let (pattern, input) = inputs::load_pattern(path)?;
-    let (model, model_input) = load_model(model_spec)?;
-    Ok((pattern, model, std::iter::once(input).chain(model_input).collect()))
+) -> anyhow::Result<(Pattern, YarnModel, Vec<InputRef>)> {
+    let pattern = open_artifact::<Pattern>(path)?;
+    let (model, model_input) = open_yarn_model(model_spec)?;
+    Ok((pattern.value, model, std::iter::once(pattern.input).chain(model_input).collect()))
 }
 
-pub(crate) fn stop_reason(reason: StopReason) -> &'static str {
-    match reason {
-        StopReason::Converged => "converged",
-        StopReason::IterationLimit => "iteration_limit",
-        StopReason::LineSearchFailed => "line_search_failed",
-        StopReason::FactorizationFailed => "factorization_failed",
+/// `--ccd D` as a step control, or the step limit of A.2.3.
+fn step_control(ccd: Option<f64>) -> anyhow::Result<StepControl> {
+    match ccd {
+        Some(d) if !(d > 0.0 && d < 2.0) => {
+            anyhow::bail!("--ccd {d}: the separation must lie strictly between 0 and 2 yarn radii")
+        }
+        Some(min_separation_radii) => Ok(StepControl::AdditiveCcd { min_separation_radii }),
+        None => Ok(StepControl::StepLimit),
     }
 }
 
 fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     let strain: MacroStrain = args.strain.parse()?;
-    let (pattern, model, inputs_list) = load_pattern_and_model(&args.pattern, &args.model)?;
-    let pattern = &pattern;
-    let tile = RveModel::new(pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
-    let step_control = match args.ccd {
-        Some(d) if !(d > 0.0 && d < 2.0) => {
-            anyhow::bail!("--ccd {d}: the separation must lie strictly between 0 and 2 yarn radii")
-        }
-        Some(min_separation_radii) => StepControl::AdditiveCcd { min_separation_radii },
-        None => StepControl::StepLimit,
+    let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
+    let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
+    let options = SolveOptions {
+        max_iterations: args.max_iterations,
+        step_control: step_control(args.ccd)?,
+        ..SolveOptions::default()
     };
-    let options =
-        SolveOptions { max_iterations: args.max_iterations, step_control, ..SolveOptions::default() };
     eprintln!(
         "solving '{}' ({} vertices) with '{}' at {}",
         pattern.name,
@@ -192,87 +173,44 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
         model.name,
         args.strain
     );
+    let metadata = TraceMetadata::new("yarnhom rve solve", env!("CARGO_PKG_VERSION"))
+        .with_entry("pattern", args.pattern.display().to_string())
+        .with_entry("model", &args.model)
+        .with_entry("strain", &args.strain);
+    let mut trace = args.trace.as_deref().map(|path| open_trace(path, &metadata)).transpose()?;
     let placement = yarnhom_rve::homogenize::placement(&tile, &strain);
-    let mut trace = match &args.trace {
-        Some(path) => {
-            let metadata = TraceMetadata::new("yarnhom rve solve", env!("CARGO_PKG_VERSION"))
-                .with_entry("pattern", args.pattern.display().to_string())
-                .with_entry("model", &args.model)
-                .with_entry("strain", &args.strain);
-            Some(TraceSink::open(path, &metadata)?)
-        }
-        None => None,
-    };
     let mut trace_error = None;
     let mut record = |iterate: &Iterate<'_>| {
         if let Some(sink) = trace.as_mut().filter(|_| trace_error.is_none()) {
             let frame = iterate.iteration as u64;
             let written = sink
-                .write(&SolverIteration {
-                    frame,
-                    time_s: 0.0,
-                    iteration: iterate.iteration as u32,
-                    energy_j: iterate.energy_j,
-                    residual: iterate.gradient_ratio,
-                    step_length: iterate.step_length,
-                })
-                .and_then(|()| sink.write(&yarn_frame(pattern, &tile, &placement, iterate.state, frame)))
+                .write(&iteration_message(iterate))
+                .and_then(|()| sink.write(&yarn_frame(&pattern, &tile, &placement, iterate.state, frame)))
                 .and_then(|()| sink.end_frame());
             trace_error = written.err();
         }
     };
-    let started = Instant::now();
-    let (report, state) = solve_at_observed(&tile, &strain, None, &options, &mut record);
-    let seconds = started.elapsed().as_secs_f64();
+    let outputs = Outputs { stress: !args.no_stress, fd_stress: args.fd_stress };
+    let result =
+        solve_to_artifact(&tile, [&pattern.name, &model.name], &strain, &options, outputs, &mut record);
     if let Some(err) = trace_error {
         return Err(anyhow::Error::new(err).context("cannot write the trace"));
     }
-    if let Some(sink) = trace {
-        sink.finish()?;
-    }
-    let stress = (report.converged && !args.no_stress).then(|| stress_at_equilibrium(&tile, &strain, &state));
-    let stress_fd = (report.converged && args.fd_stress)
-        .then(|| stress_by_finite_differences(&tile, &strain, &state))
-        .flatten();
-    let result = RveSolve {
-        pattern: pattern.name.clone(),
-        model: model.name.clone(),
-        strain: StrainSample {
-            sx: strain.s.sx,
-            sa: strain.s.sa,
-            sy: strain.s.sy,
-            kx: strain.kx,
-            ky: strain.ky,
-        },
-        converged: report.converged,
-        stop_reason: stop_reason(report.reason).into(),
-        energy_density_j_m2: report.converged.then_some(report.energy_density_j_m2),
-        stress,
-        stress_fd,
-        iterations: report.iterations as u32,
-        gradient_ratio: report.gradient_ratio,
-        seconds,
-        positions_m: yarnhom_rve::assembly::world_positions(&tile, &placement, &state),
-        edge_twist_rad: (0..tile.vertices as u32).map(|v| state.g[tile.twist_dof(v)]).collect(),
-    };
+    finish_trace(trace, args.trace.as_deref())?;
     let output = args.output.unwrap_or_else(|| format!("{}.rvesolve.yh", base_name(&args.pattern)).into());
-    container::write(&output, &result, &provenance("rve solve", inputs_list))?;
-    if args.trace.as_deref().is_some_and(is_stdout) {
-        eprintln!("{}", result.summary());
-    } else {
-        println!("{}", result.summary());
-    }
-    eprintln!("wrote {}", output.display());
-    if report.converged {
+    write_artifact(&output, &result, "rve solve", inputs)?;
+    print_summary(&result.summary(), args.trace.as_deref());
+    wrote(&output);
+    if result.converged {
         Ok(Outcome::Success)
     } else {
-        eprintln!("error: the solve did not converge ({})", stop_reason(report.reason));
+        eprintln!("error: the solve did not converge ({})", result.stop_reason);
         Ok(Outcome::Different)
     }
 }
 
 fn residual(args: ResidualArgs) -> anyhow::Result<Outcome> {
-    let (pattern, model, _) = load_pattern_and_model(&args.pattern, &args.model)?;
+    let (pattern, model, _) = open_pattern_and_model(&args.pattern, &args.model)?;
     let r = yarnhom_rve::residual::equilibrium_residual(&pattern, &model)?;
     println!(
         "forces at the stored state of '{}' under '{}' (projected on the constraints):",
@@ -293,15 +231,7 @@ fn residual(args: ResidualArgs) -> anyhow::Result<Outcome> {
 }
 
 fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
-    let (pattern, model, inputs_list) = load_pattern_and_model(&args.pattern, &args.model)?;
-    let pattern = &pattern;
-    let method = match args.estimation {
-        Some(bound) if !(bound > 0.0 && bound < 1.0) => {
-            anyhow::bail!("--estimation {bound}: the rest-length bound must lie strictly between 0 and 1")
-        }
-        Some(max_length_change) => RelaxMethod::Estimation { max_length_change },
-        None => RelaxMethod::Reference,
-    };
+    let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
     if args.keep_rest_shape && pattern.rest.is_none() {
         anyhow::bail!(
             "{}: --keep-rest-shape needs a pattern with a rest state, and '{}' has none",
@@ -310,31 +240,15 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
         );
     }
     let options = RelaxOptions {
-        method,
+        method: relax_method(args.estimation)?,
         keep_rest_shape: args.keep_rest_shape,
         max_resets: args.max_resets,
         ..RelaxOptions::default()
     };
     eprintln!("relaxing '{}' ({} vertices) with '{}'", pattern.name, pattern.vertex_count(), model.name);
     let started = Instant::now();
-    let mut show = |event: RelaxEvent| match event {
-        RelaxEvent::Reset(k, energy) => {
-            eprintln!(
-                "  reset {:>3}: relaxed tile energy {energy:.3e} J ({:.1} s)",
-                k + 1,
-                started.elapsed().as_secs_f64()
-            )
-        }
-        RelaxEvent::PeriodStep(s, sigma) => eprintln!(
-            "  periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m² ({:.1} s)",
-            s[0],
-            s[1],
-            sigma[0],
-            sigma[1],
-            started.elapsed().as_secs_f64()
-        ),
-    };
-    let (relaxed, report) = yarnhom_rve::relax(pattern, &model, &options, &mut show)
+    let mut show = |event: RelaxEvent| show_relax_event(event, started.elapsed().as_secs_f64());
+    let (relaxed, report) = yarnhom_rve::relax(&pattern, &model, &options, &mut show)
         .with_context(|| format!("{}", args.pattern.display()))?;
     if !args.keep_rest_shape && report.stress_free_energy_j >= options.stress_free_energy_j {
         eprintln!(
@@ -344,7 +258,7 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
     }
     let output =
         args.output.unwrap_or_else(|| format!("{}.relaxed.pattern.yh", base_name(&args.pattern)).into());
-    container::write(&output, &relaxed, &provenance("rve relax", inputs_list))?;
+    write_artifact(&output, &relaxed, "rve relax", inputs)?;
     let [sx, sa, sy] = report.residual_stress_j_m2;
     println!(
         "relaxed '{}': {} resets, periods {:.4} x {:.4} mm (period strain {:+.4}, {:+.4}), {} Newton iterations, {:.1} s\n  in-plane stress at zero strain: dsx {sx:.3e}, dsa {sa:.3e}, dsy {sy:.3e} J/m²",
@@ -357,6 +271,30 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
         report.iterations,
         started.elapsed().as_secs_f64()
     );
-    eprintln!("wrote {}", output.display());
+    wrote(&output);
     Ok(Outcome::Success)
+}
+
+/// A stage of a relaxation, on stderr.
+fn show_relax_event(event: RelaxEvent, seconds: f64) {
+    match event {
+        RelaxEvent::Reset(k, energy) => {
+            eprintln!("  reset {:>3}: relaxed tile energy {energy:.3e} J ({seconds:.1} s)", k + 1)
+        }
+        RelaxEvent::PeriodStep(s, sigma) => eprintln!(
+            "  periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m² ({seconds:.1} s)",
+            s[0], s[1], sigma[0], sigma[1]
+        ),
+    }
+}
+
+/// Algorithm 2, or the Sec. 6.5.2 estimation with `--estimation BOUND`.
+fn relax_method(estimation: Option<f64>) -> anyhow::Result<RelaxMethod> {
+    match estimation {
+        Some(bound) if !(bound > 0.0 && bound < 1.0) => {
+            anyhow::bail!("--estimation {bound}: the rest-length bound must lie strictly between 0 and 1")
+        }
+        Some(max_length_change) => Ok(RelaxMethod::Estimation { max_length_change }),
+        None => Ok(RelaxMethod::Reference),
+    }
 }

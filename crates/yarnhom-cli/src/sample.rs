@@ -2,8 +2,6 @@
 //! progress bar, a checkpoint after every sweep line (so a killed run resumes where it stopped)
 //! and shards (`--shard K/N`) that `yarnhom grid merge` joins bit-identically.
 
-use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 use std::time::Instant;
@@ -11,23 +9,23 @@ use std::time::Instant;
 use anyhow::Context;
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use serde::{Deserialize, Serialize};
-use yarnhom_artifacts::Pattern;
-use yarnhom_artifacts::container;
-use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard, GridTerm, strain_from_values};
+use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard};
+use yarnhom_artifacts::open::{base_name, open_artifact};
+use yarnhom_artifacts::{Pattern, Spline};
 use yarnhom_fit::sampled_ranges;
 use yarnhom_rve::RveModel;
+use yarnhom_rve::checkpoint::{Checkpoint, CheckpointLine, RunKey};
+use yarnhom_rve::messages::{sample_message, yarns_in_order};
 use yarnhom_rve::sample::{
-    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SampleRanges, SweepLine,
-    plane_axes, sample_lines, shard_lines,
+    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SweepLine, sample_lines,
+    shard_lines,
 };
-use yarnhom_trace::{RveSample, TraceError, TraceMetadata};
+use yarnhom_trace::{TraceError, TraceMetadata, TraceSink};
 
 use crate::Outcome;
-use crate::fit::{load_spline, parse_axis, parse_interval};
-use crate::inputs::{base_name, provenance};
-use crate::rve::{load_pattern_and_model, stop_reason};
-use crate::trace_out::{TraceSink, is_stdout, yarns_in_order};
+use crate::args::{parse_axis, parse_interval};
+use crate::output::{finish_trace, open_trace, print_summary, write_artifact, wrote};
+use crate::rve::open_pattern_and_model;
 
 #[derive(Debug, Args)]
 pub struct SampleArgs {
@@ -79,21 +77,6 @@ pub struct SampleArgs {
     pub output: Option<PathBuf>,
 }
 
-/// What identifies a run: a checkpoint is resumed only by the same run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct RunKey {
-    pattern_hash: String,
-    model: String,
-    n1d: usize,
-    n2d: usize,
-    /// `[lower, upper]` of each axis of each term, in plan order.
-    ranges: Vec<[f64; 2]>,
-    shard: Option<(u32, u32)>,
-    geometry: bool,
-    stress: bool,
-    max_iterations: usize,
-}
-
 /// `AXIS=MIN:MAX`.
 fn parse_range(text: &str) -> Result<(usize, [f64; 2]), String> {
     let (name, range) = text.split_once('=').ok_or("expected AXIS=MIN:MAX, e.g. sx=-0.3:0.8")?;
@@ -135,137 +118,72 @@ fn plan_ranges(args: &SampleArgs) -> anyhow::Result<PlanRanges> {
 
 /// The sampled ranges of a fitted material, as a plan's.
 fn ranges_of(path: &Path) -> anyhow::Result<PlanRanges> {
-    let recovered = sampled_ranges(&load_spline(path)?)?;
-    let single = SampleRanges {
-        lower: recovered.single.map(|[lower, _]| lower),
-        upper: recovered.single.map(|[_, upper]| upper),
-    };
-    let planes = plane_axes()
-        .into_iter()
-        .map(|axes| {
-            let [a, b] = axes.map(|axis| AXIS_NAMES[axis]);
-            recovered
-                .planes
-                .iter()
-                .find(|(p, _)| p.map(usize::from) == axes)
-                .map(|&(_, ranges)| PlaneRange { axes, ranges })
-                .with_context(|| format!("the material has no 2D term {a},{b}"))
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    Ok(PlanRanges::new(single, planes)?)
-}
-
-/// One finished sweep line in the checkpoint.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct CheckpointLine {
-    line: usize,
-    samples: Vec<GridSample>,
+    let recovered = sampled_ranges(&open_artifact::<Spline>(path)?.value)?;
+    Ok(PlanRanges::from_bounds(recovered.single, &recovered.planes)?)
 }
 
 pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
-    let (pattern, model, inputs) = load_pattern_and_model(&args.pattern, &args.model)?;
+    let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
     let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
     let plan = SamplePlan::thesis(&plan_ranges(&args)?, args.n1d, args.n2d)?;
     let shard = args.shard.as_deref().map(parse_shard).transpose()?;
-    let key = RunKey {
-        pattern_hash: inputs[0].content_hash.clone(),
-        model: model.name.clone(),
-        n1d: args.n1d,
-        n2d: args.n2d,
-        ranges: plan.terms.iter().flat_map(|t| t.values.iter().map(|v| [v[0], v[v.len() - 1]])).collect(),
-        shard: shard.map(|s| (s.index, s.count)),
-        geometry: args.geometry,
-        stress: !args.no_stress,
+    let options = SampleOptions {
         max_iterations: args.max_iterations,
+        stress: !args.no_stress,
+        geometry: args.geometry,
     };
+    let key = RunKey::new(
+        &inputs[0].content_hash,
+        &model.name,
+        &plan,
+        [args.n1d, args.n2d],
+        shard.map(|s| (s.index, s.count)),
+        &options,
+    );
     let output =
         args.output.clone().unwrap_or_else(|| format!("{}.grid.yh", base_name(&args.pattern)).into());
-    let checkpoint = PathBuf::from(format!("{}.checkpoint", output.display()));
-    let done = read_checkpoint(&checkpoint, &key)?;
-    let all_lines = plan.lines();
+    let checkpoint_path = PathBuf::from(format!("{}.checkpoint", output.display()));
+    let (checkpoint, done) = Checkpoint::resume(&checkpoint_path, &key)?;
     let mine = match shard {
-        Some(s) => shard_lines(&all_lines, s.index as usize, s.count as usize),
-        None => all_lines,
+        Some(s) => shard_lines(&plan.lines(), s.index as usize, s.count as usize),
+        None => plan.lines(),
     };
     let todo: Vec<SweepLine> =
         mine.iter().filter(|l| !done.iter().any(|d| d.line == l.index)).cloned().collect();
     let total: usize = mine.iter().map(|l| l.points.len()).sum();
     let resumed: usize = done.iter().map(|d| d.samples.len()).sum();
     eprintln!(
-        "sampling '{}' with '{}': {} of {} samples in {} sweep lines{}{}",
+        "sampling '{}' with '{}': {total} of {} samples in {} sweep lines{}{}",
         pattern.name,
         model.name,
-        total,
         plan.sample_count(),
         mine.len(),
         shard.map(|s| format!(" (shard {}/{})", s.index, s.count)).unwrap_or_default(),
         if resumed > 0 {
-            format!(", {resumed} resumed from {}", checkpoint.display())
+            format!(", {resumed} resumed from {}", checkpoint_path.display())
         } else {
             String::new()
         }
     );
-    let bar = progress_bar(total as u64, resumed as u64);
-    let writer = Mutex::new(open_checkpoint(&checkpoint, &key, &done)?);
-    let options = SampleOptions {
-        max_iterations: args.max_iterations,
-        stress: !args.no_stress,
-        geometry: args.geometry,
-    };
     let started = Instant::now();
-    let failed_write = Mutex::new(None);
-    let trace = match &args.trace {
-        Some(path) => {
-            let metadata = TraceMetadata::new("yarnhom rve sample", env!("CARGO_PKG_VERSION"))
-                .with_entry("pattern", args.pattern.display().to_string())
-                .with_entry("model", &args.model)
-                .with_entry("n1d", args.n1d.to_string())
-                .with_entry("n2d", args.n2d.to_string());
-            Some(TraceSink::open(path, &metadata)?)
-        }
-        None => None,
-    };
-    let trace = Mutex::new((trace, 0u64));
-    let failed_trace = Mutex::new(None);
-    let results = sample_lines(&tile, &plan, &todo, &options, &|line: &LineResult| {
-        let mut guard = trace.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        let (sink, written) = &mut *guard;
-        if let Some(sink) = sink.as_mut()
-            && let Err(e) = record_line(sink, written, &plan, &pattern, &tile, line)
-        {
-            failed_trace.lock().unwrap_or_else(std::sync::PoisonError::into_inner).get_or_insert(e);
-        }
-        drop(guard);
-        let record =
-            CheckpointLine { line: line.line, samples: line.samples.iter().map(grid_sample).collect() };
-        let mut w = writer.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Err(e) = append(&mut w, &record) {
-            failed_write.lock().unwrap_or_else(std::sync::PoisonError::into_inner).get_or_insert(e);
-        }
-        bar.inc(line.samples.len() as u64);
-    });
-    bar.finish_and_clear();
-    if let Some(e) = failed_write.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
-        return Err(e.context(format!("cannot write the checkpoint {}", checkpoint.display())));
-    }
-    if let Some(e) = failed_trace.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
-        return Err(anyhow::Error::new(e).context("cannot write the trace"));
-    }
-    if let (Some(sink), _) = trace.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner) {
-        sink.finish()?;
-    }
+    let trace = args.trace.as_deref().map(|path| open_trace(path, &trace_metadata(&args))).transpose()?;
+    let recorder = Recorder::new(checkpoint, trace, progress_bar(total as u64, resumed as u64));
+    let results =
+        sample_lines(&tile, &plan, &todo, &options, &|line| recorder.record(&plan, &pattern, &tile, line));
+    let (checkpoint, trace) = recorder.finish()?;
+    finish_trace(trace, args.trace.as_deref())?;
     let mut samples: Vec<GridSample> = done.into_iter().flat_map(|d| d.samples).collect();
-    samples.extend(results.iter().flat_map(|l| l.samples.iter().map(grid_sample)));
+    samples.extend(results.iter().flat_map(|l| l.samples.iter().map(SampleOutcome::to_grid_sample)));
     samples.sort_by_key(GridSample::key);
     let grid = Grid {
         pattern: pattern.name.clone(),
         model: model.name.clone(),
-        terms: grid_terms(&plan),
+        terms: plan.grid_terms(),
         shard,
         samples,
     };
-    container::write(&output, &grid, &provenance("rve sample", inputs))?;
-    std::fs::remove_file(&checkpoint).with_context(|| format!("cannot remove {}", checkpoint.display()))?;
+    write_artifact(&output, &grid, "rve sample", inputs)?;
+    checkpoint.remove()?;
     let converged = grid.samples.iter().filter(|s| s.converged).count();
     let summary = format!(
         "sampled '{}': {converged} of {} samples converged, {:.1} s this run\n{}",
@@ -274,13 +192,75 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
         started.elapsed().as_secs_f64(),
         grid.summary()
     );
-    if args.trace.as_deref().is_some_and(is_stdout) {
-        eprintln!("{summary}");
-    } else {
-        println!("{summary}");
-    }
-    eprintln!("wrote {}", output.display());
+    print_summary(&summary, args.trace.as_deref());
+    wrote(&output);
     Ok(Outcome::Success)
+}
+
+fn trace_metadata(args: &SampleArgs) -> TraceMetadata {
+    TraceMetadata::new("yarnhom rve sample", env!("CARGO_PKG_VERSION"))
+        .with_entry("pattern", args.pattern.display().to_string())
+        .with_entry("model", &args.model)
+        .with_entry("n1d", args.n1d.to_string())
+        .with_entry("n2d", args.n2d.to_string())
+}
+
+/// What the sweep does with each finished line, from whichever thread finished it: append it
+/// to the checkpoint, record its samples on the trace (numbered in completion order), advance
+/// the progress bar. The first error is kept and reported when the sweep is done.
+struct Recorder {
+    checkpoint: Mutex<Checkpoint>,
+    trace: Mutex<(Option<TraceSink>, u64)>,
+    error: Mutex<Option<anyhow::Error>>,
+    bar: ProgressBar,
+}
+
+impl Recorder {
+    fn new(checkpoint: Checkpoint, trace: Option<TraceSink>, bar: ProgressBar) -> Self {
+        Recorder {
+            checkpoint: Mutex::new(checkpoint),
+            trace: Mutex::new((trace, 0)),
+            error: Mutex::new(None),
+            bar,
+        }
+    }
+
+    fn record(&self, plan: &SamplePlan, pattern: &Pattern, tile: &RveModel, line: &LineResult) {
+        let mut trace = lock(&self.trace);
+        let (sink, written) = &mut *trace;
+        if let Some(sink) = sink.as_mut()
+            && let Err(e) = record_line(sink, written, plan, pattern, tile, line)
+        {
+            lock(&self.error).get_or_insert(anyhow::Error::new(e).context("cannot write the trace"));
+        }
+        drop(trace);
+        let record = CheckpointLine {
+            line: line.line,
+            samples: line.samples.iter().map(SampleOutcome::to_grid_sample).collect(),
+        };
+        if let Err(e) = lock(&self.checkpoint).append(&record) {
+            lock(&self.error).get_or_insert(e.into());
+        }
+        self.bar.inc(line.samples.len() as u64);
+    }
+
+    /// The checkpoint and the trace back, or the first error met.
+    fn finish(self) -> anyhow::Result<(Checkpoint, Option<TraceSink>)> {
+        self.bar.finish_and_clear();
+        if let Some(e) = into_inner(self.error) {
+            return Err(e);
+        }
+        Ok((into_inner(self.checkpoint), into_inner(self.trace).0))
+    }
+}
+
+/// A mutex's value, whether or not a thread panicked holding it.
+fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+fn into_inner<T>(mutex: Mutex<T>) -> T {
+    mutex.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Writes the samples of a finished line to the trace, numbering them on from `written`.
@@ -295,17 +275,7 @@ fn record_line(
     for s in &line.samples {
         let frame = *written;
         *written += 1;
-        sink.write(&RveSample {
-            frame,
-            time_s: 0.0,
-            term: plan.terms[s.term].axes.iter().map(|&a| AXIS_NAMES[a]).collect::<Vec<_>>().join(","),
-            grid_index: s.index,
-            strain: s.strain,
-            converged: s.converged,
-            energy_density_j_m2: s.energy_density_j_m2,
-            stress: s.stress,
-            iterations: s.iterations as u32,
-        })?;
+        sink.write(&sample_message(plan, s, frame))?;
         if let (Some(positions), Some(twists)) = (&s.positions_m, &s.edge_twist_rad) {
             sink.write(&yarns_in_order(pattern, tile, positions, twists, frame))?;
         }
@@ -331,72 +301,4 @@ fn progress_bar(total: u64, done: u64) -> ProgressBar {
     );
     bar.set_position(done);
     bar
-}
-
-fn grid_terms(plan: &SamplePlan) -> Vec<GridTerm> {
-    plan.terms
-        .iter()
-        .map(|t| GridTerm { axes: t.axes.iter().map(|&a| a as u8).collect(), values: t.values.clone() })
-        .collect()
-}
-
-fn grid_sample(s: &SampleOutcome) -> GridSample {
-    GridSample {
-        term: s.term as u32,
-        index: s.index,
-        strain: strain_from_values(s.strain),
-        converged: s.converged,
-        stop_reason: stop_reason(s.stop_reason).into(),
-        energy_density_j_m2: s.energy_density_j_m2,
-        stress: s.stress,
-        iterations: s.iterations as u32,
-        positions_m: s.positions_m.clone(),
-        edge_twist_rad: s.edge_twist_rad.clone(),
-    }
-}
-
-/// The lines a checkpoint of this run already holds (none if there is no checkpoint). A
-/// checkpoint of another run is an error rather than silently discarded work; a record cut
-/// short by a kill is dropped.
-fn read_checkpoint(path: &Path, key: &RunKey) -> anyhow::Result<Vec<CheckpointLine>> {
-    let file = match File::open(path) {
-        Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
-    };
-    let mut reader = BufReader::new(file);
-    let stored: RunKey = rmp_serde::from_read(&mut reader)
-        .with_context(|| format!("{}: not a yarnhom sampling checkpoint", path.display()))?;
-    if &stored != key {
-        anyhow::bail!(
-            "{}: a checkpoint of another run (pattern, model, plan or options differ); delete it to start over",
-            path.display()
-        );
-    }
-    let mut lines = Vec::new();
-    while let Ok(line) = rmp_serde::from_read::<_, CheckpointLine>(&mut reader) {
-        lines.push(line);
-    }
-    Ok(lines)
-}
-
-/// The checkpoint, written anew with the run's key and the lines already done (a record cut
-/// short by a kill is not carried over), open for appending the next lines.
-fn open_checkpoint(path: &Path, key: &RunKey, done: &[CheckpointLine]) -> anyhow::Result<BufWriter<File>> {
-    let file =
-        File::create(path).with_context(|| format!("cannot write the checkpoint {}", path.display()))?;
-    let mut writer = BufWriter::new(file);
-    append(&mut writer, key)?;
-    for line in done {
-        append(&mut writer, line)?;
-    }
-    Ok(writer)
-}
-
-/// Append one msgpack record and flush it to the file.
-fn append<T: Serialize>(writer: &mut BufWriter<File>, value: &T) -> anyhow::Result<()> {
-    rmp_serde::encode::write_named(writer, value)?;
-    writer.flush()?;
-    writer.get_ref().sync_data()?;
-    Ok(())
 }

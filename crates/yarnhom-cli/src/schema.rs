@@ -6,6 +6,7 @@ use clap::Args;
 use yarnhom_artifacts::{KINDS, json_schema, schema, schema_version};
 
 use crate::Outcome;
+use crate::output::write_text;
 
 #[derive(Debug, Args)]
 pub struct SchemaArgs {
@@ -25,8 +26,7 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
         for kind in KINDS {
             let path = dir.join(schema::file_name(kind, schema_version(kind)?));
             let text = serde_json::to_string_pretty(&json_schema(kind)?)? + "\n";
-            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
-            eprintln!("wrote {}", path.display());
+            write_text(&path, &text)?;
         }
         let reports = [
             (
@@ -48,16 +48,14 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
         for (name, version, schema) in reports {
             let path = dir.join(format!("{name}.v{version}.schema.json"));
             let text = serde_json::to_string_pretty(&schema)? + "\n";
-            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
-            eprintln!("wrote {}", path.display());
+            write_text(&path, &text)?;
         }
         let trace_dir = dir.join("trace");
         std::fs::create_dir_all(&trace_dir)?;
         for (_, name, schema) in yarnhom_trace::topic_schemas() {
             let path = trace_dir.join(format!("{name}.schema.json"));
             let text = serde_json::to_string_pretty(&schema)? + "\n";
-            yarnhom_artifacts::container::write_atomic(&path, text.as_bytes()).map_err(|e| e.at(&path))?;
-            eprintln!("wrote {}", path.display());
+            write_text(&path, &text)?;
         }
     } else if let Some(kind) = args.kind {
         println!("{}", serde_json::to_string_pretty(&json_schema(&kind)?)?);

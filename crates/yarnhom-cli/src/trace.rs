@@ -3,17 +3,16 @@
 //! time, so they chain with pipes:
 //! `yarnhom shell simulate drape -o - | yarnhom trace decimate --every 4 | yarnhom trace info`.
 
-use std::fs::File;
-use std::io::{BufReader, Read, Write};
+use std::io::Write;
 use std::ops::Range;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_trace::filter::{self, FilterStats, Selection};
-use yarnhom_trace::{RecordReader, TraceMetadata};
+use yarnhom_trace::{TraceMetadata, open_records};
 
 use crate::Outcome;
-use crate::trace_out::{TraceSink, with_writer};
+use crate::output::{finish_trace, open_trace};
 
 #[derive(Debug, Subcommand)]
 pub enum TraceCommand {
@@ -120,23 +119,9 @@ pub fn run(cmd: TraceCommand) -> anyhow::Result<Outcome> {
     }
 }
 
-/// Opens the bytes of a trace: a file, or standard input for `-`.
-pub fn open_source(path: &str) -> anyhow::Result<Box<dyn Read>> {
-    Ok(if path == "-" {
-        Box::new(std::io::stdin().lock())
-    } else {
-        Box::new(BufReader::new(File::open(path).with_context(|| format!("cannot open the trace {path}"))?))
-    })
-}
-
-/// Opens a trace input's records: a file, or standard input for `-`.
-pub fn open_input(path: &str) -> anyhow::Result<RecordReader<Box<dyn Read>>> {
-    Ok(RecordReader::new(open_source(path)?))
-}
-
 fn info(args: InfoArgs) -> anyhow::Result<Outcome> {
     let summary =
-        filter::info(open_input(&args.input)?).with_context(|| format!("reading {}", args.input))?;
+        filter::info(open_records(&args.input)?).with_context(|| format!("reading {}", args.input))?;
     if args.json {
         writeln!(std::io::stdout().lock(), "{}", serde_json::to_string_pretty(&summary)?)?;
     } else {
@@ -152,11 +137,10 @@ fn filter_metadata(command: &str, inputs: &[String]) -> TraceMetadata {
 }
 
 fn run_filter(input: &str, output: &str, command: &str, selection: &Selection) -> anyhow::Result<Outcome> {
-    let reader = open_input(input)?;
-    let mut sink = TraceSink::open(output, &filter_metadata(command, &[input.to_owned()]))?;
-    let stats = with_writer!(&mut sink, w => filter::filter(reader, w, selection))
-        .with_context(|| format!("{command} {input}"))?;
-    sink.finish()?;
+    let reader = open_records(input)?;
+    let mut sink = open_trace(output, &filter_metadata(command, &[input.to_owned()]))?;
+    let stats = sink.filter(reader, selection).with_context(|| format!("{command} {input}"))?;
+    finish_trace(Some(sink), Some(output))?;
     report(command, &stats, &[input.to_owned()]);
     Ok(Outcome::Success)
 }
@@ -166,10 +150,10 @@ fn merge(args: MergeArgs) -> anyhow::Result<Outcome> {
         args.inputs.iter().filter(|i| *i == "-").count() <= 1,
         "standard input (`-`) can be given once only"
     );
-    let readers = args.inputs.iter().map(|i| open_input(i)).collect::<anyhow::Result<Vec<_>>>()?;
-    let mut sink = TraceSink::open(&args.output, &filter_metadata("trace merge", &args.inputs))?;
-    let stats = with_writer!(&mut sink, w => filter::merge(readers, w)).context("trace merge")?;
-    sink.finish()?;
+    let readers = args.inputs.iter().map(|i| open_records(i)).collect::<Result<Vec<_>, _>>()?;
+    let mut sink = open_trace(&args.output, &filter_metadata("trace merge", &args.inputs))?;
+    let stats = sink.merge(readers).context("trace merge")?;
+    finish_trace(Some(sink), Some(&args.output))?;
     report("trace merge", &stats, &args.inputs);
     Ok(Outcome::Success)
 }

@@ -9,7 +9,7 @@ use clap::{Args, ValueEnum};
 use yarnhom_trace::export::{self, ExportStats, FrameFormat};
 
 use crate::Outcome;
-use crate::trace::open_input;
+use yarnhom_trace::open_records;
 
 /// What `trace export` writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -50,13 +50,13 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
 }
 
 fn export_frames(args: &ExportArgs, format: FrameFormat) -> anyhow::Result<ExportStats> {
-    export::export_frames(open_input(&args.input)?, &args.output, format)
+    export::export_frames(open_records(&args.input)?, &args.output, format)
         .with_context(|| format!("trace export {} to {}", args.input, args.output.display()))
 }
 
 #[cfg(feature = "hdf5")]
 fn export_hdf5(args: &ExportArgs) -> anyhow::Result<ExportStats> {
-    export::export_hdf5(open_input(&args.input)?, &args.output, &args.input)
+    export::export_hdf5(open_records(&args.input)?, &args.output, &args.input)
         .with_context(|| format!("trace export {} to {}", args.input, args.output.display()))
 }
 

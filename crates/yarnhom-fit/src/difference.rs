@@ -221,11 +221,12 @@ mod tests {
     use std::collections::BTreeSet;
 
     use super::*;
-    use yarnhom_artifacts::arcsim::read_spline;
 
     fn published(name: &str) -> Spline {
         let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
-        read_spline(std::path::Path::new(&path)).expect("published material")
+        yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .map(|o| o.value)
+            .expect("published material")
     }
 
     const EXACT: Tolerance = Tolerance { rtol: 0.0, atol: 0.0 };

@@ -10,6 +10,7 @@ use yarnhom_artifacts::grid::strain_values;
 use yarnhom_artifacts::{
     AxisLimit, BicubicTerm, CubicTerm, FitSettings, Grid, GridSample, GridTerm, Spline, SplineOrigin,
 };
+use yarnhom_geom::stats::root_mean_square;
 
 use crate::hermite::Cubic;
 use crate::march::{
@@ -524,10 +525,8 @@ fn mirrored_symlog_energy(
 
 /// RMS of (fit - data) over RMS of (data - offset), for `(fit, data)` pairs.
 fn relative_rms(pairs: &[(f64, f64)], offset: f64) -> f64 {
-    let rms = |f: &dyn Fn(&(f64, f64)) -> f64| {
-        (pairs.iter().map(|p| f(p).powi(2)).sum::<f64>() / pairs.len().max(1) as f64).sqrt()
-    };
-    rms(&|(fit, data)| fit - data) / rms(&|(_, data)| data - offset)
+    root_mean_square(pairs.iter().map(|(fit, data)| fit - data))
+        / root_mean_square(pairs.iter().map(|(_, data)| data - offset))
 }
 
 #[cfg(test)]

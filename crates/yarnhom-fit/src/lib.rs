@@ -8,6 +8,7 @@
 //! - [`residual`]: residualization (A.37, A.38).
 //! - [`shape`]: single-minimum checks of the fitted terms (A.36).
 //! - [`ranges`]: the strain ranges a fitted material was sampled over, from its control points.
+//! - [`compare`]: two materials' 1D terms compared over the strains both were fitted on.
 //! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
 //! - [`curvature`]: the curvature split (A.39)-(A.41), smooth at umbilics.
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
@@ -15,6 +16,7 @@
 //! - [`difference`]: two spline materials compared by their energies and stresses on a dense
 //!   strain plan (`yarnhom diff`).
 
+pub mod compare;
 pub mod curvature;
 pub mod difference;
 pub mod fit;
@@ -29,6 +31,7 @@ pub mod residual;
 pub mod shape;
 pub mod synthetic;
 
+pub use compare::{TermComparison, compare_1d_terms};
 pub use difference::diff_spline_materials;
 pub use fit::{FitError, RegularizedFit, TermError, fit_errors, fit_grid, fit_grid_with_regularized_terms};
 pub use material::{EnergyJet, SplineMaterial};

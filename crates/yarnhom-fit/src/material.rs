@@ -304,11 +304,14 @@ fn planar_strain_values(first: [f64; 3]) -> Vector3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use yarnhom_artifacts::arcsim::read_spline;
 
     fn published(name: &str) -> SplineMaterial {
         let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
-        SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published material"))
+        SplineMaterial::from(
+            &yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+                .map(|o| o.value)
+                .expect("published material"),
+        )
     }
 
     #[test]

@@ -312,9 +312,7 @@ mod tests {
         let xs: Vec<f64> = (0..400).map(|k| -1.0 + 2.0 * k as f64 / 399.0).collect();
         let noisy: Vec<f64> = xs.iter().map(|&x| truth(x) + 0.1 * rng.normal()).collect();
         let rms = |f: &dyn Fn(f64, f64) -> f64| {
-            (xs.iter().zip(&noisy).map(|(&x, &y)| (f(x, y) - truth(x)).powi(2)).sum::<f64>()
-                / xs.len() as f64)
-                .sqrt()
+            yarnhom_geom::stats::root_mean_square(xs.iter().zip(&noisy).map(|(&x, &y)| f(x, y) - truth(x)))
         };
         let raw = rms(&|_, y| y);
         let smoothed = rms(&|x, _| mls_1d(&xs, &noisy, x, 0.25).unwrap_or(f64::NAN));

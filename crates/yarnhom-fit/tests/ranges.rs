@@ -1,6 +1,5 @@
 //! The sampled ranges recovered from a fitted material's control points.
 
-use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_artifacts::{FitSettings, Spline};
 use yarnhom_fit::fit::fit_grid;
 use yarnhom_fit::ranges::STOCKINETTE_SPAN_2D_BENDING;
@@ -9,7 +8,9 @@ use yarnhom_fit::{RangeError, sampled_ranges};
 
 fn published(name: &str) -> Spline {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
-    read_spline(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{path}: {e}"))
+    yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+        .map(|o| o.value)
+        .unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 /// Whether `x` is a whole multiple of `step` (to rounding).

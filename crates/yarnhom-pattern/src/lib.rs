@@ -16,8 +16,10 @@ pub mod weave;
 use yarnhom_artifacts::{Fabric, Pattern, Yarn};
 
 use knit::Stitch::{self, Knit as K, Purl as P};
-pub use min_distance::{EdgeRef, MinDistance, YarnNeighbours, edge_clearances, min_inter_yarn_distance};
-pub use mirror::{Mirror, MirrorAxis, MirrorError, find_mirror, mirrored, root_mean_square};
+pub use min_distance::{
+    EdgeRef, MinDistance, YarnNeighbours, closest_yarns, edge_clearances, min_inter_yarn_distance,
+};
+pub use mirror::{Mirror, MirrorAxis, MirrorError, find_mirror, mirrored};
 
 /// The smallest centreline distance between yarn pieces that a generated pattern keeps, in yarn
 /// radii (touching yarns are 2 radii apart; the published relaxed tiles come to 1.87-1.98).

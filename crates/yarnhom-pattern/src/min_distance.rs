@@ -84,6 +84,23 @@ impl YarnNeighbours {
     }
 }
 
+/// Where a pattern's yarn centrelines come closest, in radii of the first yarn of the pair, as a line
+/// for `yarnhom inspect`: about 2 for touching yarns, well below for interpenetrating ones.
+pub fn closest_yarns(p: &Pattern) -> String {
+    match min_inter_yarn_distance(p) {
+        Some(m) => format!(
+            "closest centrelines: {:.3} radii apart (yarn {} edge {}, yarn {} edge {} in tile {:?})",
+            m.distance_m / p.yarns[m.a.yarn].radius_m,
+            m.a.yarn,
+            m.a.index,
+            m.b.yarn,
+            m.b.index,
+            m.image
+        ),
+        None => "closest centrelines: no two yarn pieces to compare".into(),
+    }
+}
+
 /// The smallest centreline distance between edges of different yarn pieces (see
 /// [`YarnNeighbours`]) over all periodic images: first the tile and its 8 neighbouring images;
 /// then, if the tile is small against the distance found (a segment at a farther image could

@@ -21,6 +21,7 @@
 
 use nalgebra::Vector3;
 use yarnhom_artifacts::{Pattern, RestState};
+use yarnhom_geom::stats::root_mean_square;
 
 /// The in-plane coordinate a mirror negates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -88,6 +89,47 @@ impl Mirror {
     /// Root mean square distance of the vertices from their mirror images (m).
     pub fn rms_distance_m(&self) -> f64 {
         root_mean_square(self.residual_m.iter().map(|r| Vector3::from(*r).norm()))
+    }
+
+    /// The mirror as `yarnhom pattern mirror` prints it: which yarn maps onto which, the
+    /// translation, and the RMS and largest distances of the vertices and of the centrelines
+    /// from their images, in mm and in radii of the thinnest yarn.
+    pub fn report(&self, pattern: &Pattern) -> String {
+        let (r_lo, _) = pattern.radius_range_m();
+        let mut lines = vec![format!(
+            "mirror {} of {} ({} yarn(s), {} vertices)",
+            self.axis,
+            pattern.name,
+            pattern.yarns.len(),
+            pattern.vertex_count()
+        )];
+        for (y, (partner, reversed)) in self.partner.iter().zip(&self.reversed).enumerate() {
+            let way = if *reversed { "backwards" } else { "forwards" };
+            lines.push(format!("  yarn {y} <- yarn {partner}, {way}"));
+        }
+        let t = self.shift_m;
+        lines.push(format!("  translation ({:.4}, {:.4}, {:.4}) mm", t[0] * 1e3, t[1] * 1e3, t[2] * 1e3));
+        let distances = |rms: f64, max: f64| {
+            format!(
+                "{:.4} mm RMS ({:.3} radii), {:.4} mm at most ({:.3} radii)",
+                rms * 1e3,
+                rms / r_lo,
+                max * 1e3,
+                max / r_lo
+            )
+        };
+        lines.push(format!(
+            "  vertices from their images: {}",
+            distances(self.rms_distance_m(), self.max_distance_m())
+        ));
+        let curves = self.centreline_distances_m(pattern);
+        let (rms, max) =
+            (root_mean_square(curves.iter().copied()), curves.iter().copied().fold(0.0, f64::max));
+        lines.push(format!(
+            "  centrelines from their images (shapes only, vertex spacing aside): {}",
+            distances(rms, max)
+        ));
+        lines.join("\n")
     }
 
     /// Largest distance of a vertex from its mirror image (m).
@@ -272,12 +314,6 @@ fn matches_under_shift(
         }
     }
     Some((out, total))
-}
-
-/// Root mean square of `distances` (0 for none): of [`Mirror::centreline_distances_m`], say.
-pub fn root_mean_square(distances: impl ExactSizeIterator<Item = f64>) -> f64 {
-    let n = distances.len().max(1) as f64;
-    (distances.map(|d| d * d).sum::<f64>() / n).sqrt()
 }
 
 /// The mirror image about `axis` closest to the tile: every candidate for the first yarn fixes

@@ -1,7 +1,8 @@
 //! Mirror images and symmetrization of periodic tiles, on generated and published tiles.
 
 use yarnhom_artifacts::{Pattern, pyp::parse_pyp};
-use yarnhom_pattern::{GeneratorParams, MirrorAxis, find_mirror, generate, mirrored, root_mean_square};
+use yarnhom_geom::stats::root_mean_square;
+use yarnhom_pattern::{GeneratorParams, MirrorAxis, find_mirror, generate, mirrored};
 
 fn published(name: &str) -> Pattern {
     let path = format!("{}/../../../shared/data/hylc-patterns/{name}.pyp", env!("CARGO_MANIFEST_DIR"));

@@ -7,7 +7,8 @@
 //! periods moved to the in-plane minimum: Algorithm 2's last stage) or `relaxed` (Algorithm 2
 //! from the published geometry).
 
-use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_artifacts::Spline;
+use yarnhom_artifacts::open::open_artifact;
 use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
 use yarnhom_fit::SplineMaterial;
 use yarnhom_geom::MacroStrain;
@@ -40,8 +41,7 @@ fn main() {
         let text = std::fs::read_to_string(format!("{DATA}/hylc-patterns/{name}.pyp")).expect("pattern");
         let pattern = parse_pyp(&text, name, None).expect("imports");
         let path = format!("{DATA}/hylc-materials/{name}1.json");
-        let fit =
-            SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published fit imports"));
+        let fit = SplineMaterial::from(&open_artifact::<Spline>(&path).expect("published fit imports").value);
         let yarn = YarnModel::table_4_1(name).expect("row");
         let model = RveModel::new(&pattern_for(&mode, pattern, &yarn), &yarn).expect("tile");
         let zero: MacroStrain = "sx=0".parse().expect("strain");

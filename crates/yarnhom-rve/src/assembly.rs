@@ -36,7 +36,7 @@ pub enum Want {
     /// Energy, gradient and Hessian.
     Derivatives,
     /// Energy, gradient and the Hessian's lower triangle (`row >= column`): all that a
-    /// symmetric factorization reads ([`crate::linear::SpdSolver`]), in half the triplets.
+    /// symmetric factorization reads ([`yarnhom_sparse::SpdSolver`]), in half the triplets.
     DerivativesLower,
 }
 

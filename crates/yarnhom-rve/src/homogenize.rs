@@ -4,7 +4,9 @@ use nalgebra::Vector3;
 use rayon::prelude::*;
 use yarnhom_geom::{MacroStrain, StrainError};
 
-use crate::assembly::{ContactCandidates, RveState, Want, assemble, assemble_with};
+use yarnhom_artifacts::{RveSolve, StrainSample};
+
+use crate::assembly::{ContactCandidates, RveState, Want, assemble, assemble_with, world_positions};
 use crate::model::RveModel;
 use crate::placement::Placement;
 use crate::solve::{
@@ -51,6 +53,51 @@ pub fn solve_at_observed(
     };
     let report = solve_observed(model, &placement, &mut state, options, observe);
     (report, state)
+}
+
+/// What [`solve_to_artifact`] computes besides the equilibrium.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Outputs {
+    /// The stress at equilibrium (3.23c).
+    pub stress: bool,
+    /// Its check by finite differences of ten warm-started solves.
+    pub fd_stress: bool,
+}
+
+/// Solves the tile at `strain` from the affine start, showing every Newton iterate to
+/// `observe`, and reports it as an `rvesolve` artifact: the homogenized energy density (3.22)
+/// and the `outputs` asked for where the solve converged, the equilibrium geometry, the solve's
+/// statistics and wall time. `pattern` and `model` name the tile's pattern and yarn model.
+pub fn solve_to_artifact(
+    tile: &RveModel,
+    [pattern, model]: [&str; 2],
+    strain: &MacroStrain,
+    options: &SolveOptions,
+    outputs: Outputs,
+    observe: &mut dyn FnMut(&Iterate<'_>),
+) -> RveSolve {
+    let started = std::time::Instant::now();
+    let (report, state) = solve_at_observed(tile, strain, None, options, observe);
+    let seconds = started.elapsed().as_secs_f64();
+    let converged = report.converged;
+    let [sx, sa, sy, kx, ky] = strain_vector(strain);
+    RveSolve {
+        pattern: pattern.into(),
+        model: model.into(),
+        strain: StrainSample { sx, sa, sy, kx, ky },
+        converged,
+        stop_reason: report.reason.as_str().into(),
+        energy_density_j_m2: converged.then_some(report.energy_density_j_m2),
+        stress: (converged && outputs.stress).then(|| stress_at_equilibrium(tile, strain, &state)),
+        stress_fd: (converged && outputs.fd_stress)
+            .then(|| stress_by_finite_differences(tile, strain, &state))
+            .flatten(),
+        iterations: report.iterations as u32,
+        gradient_ratio: report.gradient_ratio,
+        seconds,
+        positions_m: world_positions(tile, &placement(tile, strain), &state),
+        edge_twist_rad: (0..tile.vertices as u32).map(|v| state.g[tile.twist_dof(v)]).collect(),
+    }
 }
 
 /// The start of a solve one step further along a sweep of strains: the secant predictor of a

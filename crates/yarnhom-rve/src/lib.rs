@@ -15,18 +15,21 @@
 //!   itself does not collide with itself);
 //! - [`ccd`]: additive continuous collision detection for collision-safe steps (A.2.3);
 //! - [`mod@solve`]: the constrained Newton solve for the tile's equilibrium;
-//! - [`linear`]: sparse Cholesky with reused symbolic analysis;
-//! - [`homogenize`]: energy density and stress at a macro strain;
+//! - [`homogenize`]: energy density and stress at a macro strain, and a solve reported as an
+//!   `rvesolve` artifact;
+//! - [`messages`]: the tile's states and samples as trace messages;
 //! - [`mod@relax`]: rest states (Algorithm 2, Sec. 6.5.2);
 //! - [`residual`]: the forces left at a stored state (is a published rest state an equilibrium
 //!   of this model, and of which contact stiffness?);
-//! - [`sample`]: the sampling plan and parallel sweep engine of the energy database (App. A.3.1).
+//! - [`sample`]: the sampling plan and parallel sweep engine of the energy database (App. A.3.1);
+//! - [`checkpoint`]: the resumable record of a sampling run's finished lines.
 
 pub mod assembly;
 pub mod broadphase;
 pub mod ccd;
+pub mod checkpoint;
 pub mod homogenize;
-pub mod linear;
+pub mod messages;
 pub mod model;
 pub mod placement;
 pub mod relax;

@@ -15,6 +15,7 @@
 use std::time::Instant;
 
 use rayon::prelude::*;
+use yarnhom_artifacts::grid::{GridSample, GridTerm, strain_from_values};
 use yarnhom_geom::MacroStrain;
 
 use crate::assembly::{RveState, world_positions};
@@ -156,6 +157,27 @@ impl PlanRanges {
             }
         }
         Ok(PlanRanges { single, planes })
+    }
+
+    /// Ranges from bounds: `single[axis]` of each 1D term, and per 2D term its axes (ascending)
+    /// and `[lower, upper]` of each (as `yarnhom_fit::ranges::sampled_ranges` recovers them from
+    /// a fitted material), in any order; every plane of [`plane_axes`] must be there.
+    pub fn from_bounds(
+        single: [[f64; 2]; 5],
+        planes: &[([u8; 2], [[f64; 2]; 2])],
+    ) -> Result<Self, SampleError> {
+        let single =
+            SampleRanges { lower: single.map(|[lower, _]| lower), upper: single.map(|[_, upper]| upper) };
+        let planes = plane_axes()
+            .into_iter()
+            .map(|axes| {
+                let found = planes.iter().find(|(p, _)| p.map(usize::from) == axes);
+                found.map(|&(_, ranges)| PlaneRange { axes, ranges }).ok_or_else(|| {
+                    SampleError::Planes(planes.iter().map(|(p, _)| p.map(usize::from)).collect())
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::new(single, planes)
     }
 
     /// The plane of `axes`, if it is one of [`plane_axes`].
@@ -303,6 +325,14 @@ impl SamplePlan {
         Ok(SamplePlan { terms: singles.chain(pairs).collect() })
     }
 
+    /// The terms as a `grid` artifact stores them.
+    pub fn grid_terms(&self) -> Vec<GridTerm> {
+        self.terms
+            .iter()
+            .map(|t| GridTerm { axes: t.axes.iter().map(|&a| a as u8).collect(), values: t.values.clone() })
+            .collect()
+    }
+
     /// Number of samples over all terms (thesis: `5 · 150 + 9 · 50² = 23250`).
     pub fn sample_count(&self) -> usize {
         self.terms.iter().map(PlanTerm::sample_count).sum()
@@ -403,6 +433,24 @@ pub struct SampleOutcome {
     pub positions_m: Option<Vec<[f64; 3]>>,
     /// Twist of each edge (by source vertex) at the end of the solve, when asked for (rad).
     pub edge_twist_rad: Option<Vec<f64>>,
+}
+
+impl SampleOutcome {
+    /// The sample as a `grid` artifact stores it.
+    pub fn to_grid_sample(&self) -> GridSample {
+        GridSample {
+            term: self.term as u32,
+            index: self.index,
+            strain: strain_from_values(self.strain),
+            converged: self.converged,
+            stop_reason: self.stop_reason.as_str().into(),
+            energy_density_j_m2: self.energy_density_j_m2,
+            stress: self.stress,
+            iterations: self.iterations as u32,
+            positions_m: self.positions_m.clone(),
+            edge_twist_rad: self.edge_twist_rad.clone(),
+        }
+    }
 }
 
 /// The samples of one line, in the line's order.

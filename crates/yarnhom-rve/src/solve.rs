@@ -26,9 +26,9 @@ use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 use crate::assembly::{Assembled, ContactCandidates, RveState, Want, assemble, assemble_with};
 use crate::ccd::max_collision_free_step;
-use crate::linear::SpdSolver;
 use crate::model::RveModel;
 use crate::placement::Placement;
+use yarnhom_sparse::SpdSolver;
 
 /// `ε_L` of App. A.2.3: constraints hold to this fraction of the yarn radius at convergence.
 const CONSTRAINT_TOLERANCE: f64 = 1e-4;
@@ -94,6 +94,18 @@ pub enum StopReason {
     LineSearchFailed,
     /// The regularized system stayed indefinite.
     FactorizationFailed,
+}
+
+impl StopReason {
+    /// The reason as artifacts and traces write it (`converged`, `iteration_limit`, ...).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            StopReason::Converged => "converged",
+            StopReason::IterationLimit => "iteration_limit",
+            StopReason::LineSearchFailed => "line_search_failed",
+            StopReason::FactorizationFailed => "factorization_failed",
+        }
+    }
 }
 
 /// What a solve did.

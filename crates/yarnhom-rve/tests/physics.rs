@@ -1,7 +1,6 @@
 //! Physics of the published patterns with their Table 4.1 parameters (issue 3, "Validation").
 //! About 20 s in all (the rib tile's solves take 3 s each).
 
-use yarnhom_artifacts::arcsim::read_spline;
 use yarnhom_artifacts::{Pattern, YarnModel, pyp::parse_pyp};
 use yarnhom_fit::SplineMaterial;
 use yarnhom_geom::MacroStrain;
@@ -92,7 +91,11 @@ fn wovens_are_stiffer_in_stretch_than_knits_of_the_same_yarn() {
 /// The published HYLC fit's 1D term `k` (0 = sx) at strain `x`.
 fn published_term(name: &str, k: usize, x: f64) -> f64 {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}1.json", env!("CARGO_MANIFEST_DIR"));
-    let fit = SplineMaterial::from(&read_spline(std::path::Path::new(&path)).expect("published fit imports"));
+    let fit = SplineMaterial::from(
+        &yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .map(|o| o.value)
+            .expect("published fit imports"),
+    );
     fit.term_1d(k, x).expect("the fit has the term")
 }
 

@@ -3,7 +3,7 @@
 use std::collections::HashSet;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use yarnhom_artifacts::{YarnModel, arcsim::read_spline, pyp::parse_pyp};
+use yarnhom_artifacts::{YarnModel, pyp::parse_pyp};
 use yarnhom_fit::sampled_ranges;
 use yarnhom_rve::RveModel;
 use yarnhom_rve::sample::{
@@ -48,8 +48,12 @@ fn ranges_must_contain_zero_and_stay_valid_strains() {
 #[test]
 fn the_default_ranges_are_those_of_the_published_stockinette_fit() {
     let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
-    let published =
-        sampled_ranges(&read_spline(std::path::Path::new(&path)).expect("stock1.json")).expect("ranges");
+    let published = sampled_ranges(
+        &yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .map(|o| o.value)
+            .expect("stock1.json"),
+    )
+    .expect("ranges");
     let close = |a: [f64; 2], b: [f64; 2]| a.iter().zip(b).all(|(x, y)| (x - y).abs() <= 1e-9 * y.abs());
     let ranges = PlanRanges::default();
     for (axis, &range) in published.single.iter().enumerate() {
@@ -259,30 +263,4 @@ fn sweeps_are_identical_for_any_thread_count_and_sharding() {
         (0..2).flat_map(|i| run_on(2, &model, &plan, &shard_lines(&lines, i, 2))).collect();
     sharded.sort_by_key(|r| r.line);
     assert_eq!(sharded, serial, "2 shards");
-}
-
-/// Timing of a 9 × 5 plan (`cargo test -p yarnhom-rve --test sample -- --ignored --nocapture`).
-#[test]
-#[ignore = "timing"]
-fn timing_of_a_9_by_5_plan() {
-    let model = stocktiniest();
-    let plan = SamplePlan::thesis(&PlanRanges::default(), 9, 5).expect("plan");
-    let lines = plan.lines();
-    let started = std::time::Instant::now();
-    let results = sample_lines(&model, &plan, &lines, &SampleOptions::default(), &|_| {});
-    let seconds = started.elapsed().as_secs_f64();
-    let samples: Vec<_> = results.iter().flat_map(|r| &r.samples).collect();
-    let converged = samples.iter().filter(|s| s.converged).count();
-    let iterations: usize = samples.iter().map(|s| s.iterations).sum();
-    let solve_seconds: f64 = samples.iter().map(|s| s.seconds).sum();
-    println!(
-        "{} samples ({converged} converged, {iterations} iterations) in {seconds:.2} s on {} threads: \
-         {:.1} samples/s; {solve_seconds:.2} s summed over samples",
-        samples.len(),
-        rayon::current_num_threads(),
-        samples.len() as f64 / seconds
-    );
-    for s in samples.iter().filter(|s| !s.converged) {
-        println!("not converged: term {} {:?} {:?} after {}", s.term, s.strain, s.stop_reason, s.iterations);
-    }
 }

@@ -5,7 +5,8 @@
 //! frame, Δt = 0.209 ms; the built-ins 4; the last argument is the linear solver). With `PROBE_DUMP=FILE` it writes the final positions, one vertex `x y z` per
 //! line, to compare runs (the README's accuracy figures for one Newton iteration per step).
 
-use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_artifacts::Spline;
+use yarnhom_artifacts::open::open_artifact;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::Scene;
 use yarnhom_shell::ShellMaterial;
@@ -18,7 +19,7 @@ fn main() {
     let n: usize = args.get(3).and_then(|a| a.parse().ok()).unwrap_or(25);
     let steps: usize = args.get(4).and_then(|a| a.parse().ok()).unwrap_or(20);
     let path = format!("{}/../../../shared/data/hylc-materials/{material}.json", env!("CARGO_MANIFEST_DIR"));
-    let spline = read_spline(std::path::Path::new(&path)).expect("published material");
+    let spline = open_artifact::<Spline>(&path).expect("published material").value;
     let mut scene = Scene::builtin(scene_name).expect("built-in scene");
     scene.vertices = [n, n];
     if let Some(tolerance) = args.get(5).and_then(|a| a.parse().ok()) {

@@ -587,7 +587,9 @@ mod tests {
     /// triangle of it.
     fn honeycomb_on_a_curved_mesh() -> (ElasticModel, Vec<Vector3<f64>>, usize) {
         let path = format!("{}/../../../shared/data/hylc-materials/honey1.json", env!("CARGO_MANIFEST_DIR"));
-        let spline = yarnhom_artifacts::arcsim::read_spline(std::path::Path::new(&path)).expect("published");
+        let spline = yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .expect("published")
+            .value;
         let material = ShellMaterial::spline(yarnhom_fit::SplineMaterial::from(&spline));
         let mesh = ShellMesh::rectangle(0.02, 0.02, 5, 5).expect("mesh");
         let model = ElasticModel::new(mesh.clone(), material);

@@ -7,101 +7,8 @@
 //!   with the anisotropic edge bending (6.4).
 
 use nalgebra::{Matrix3, Vector3, Vector6};
-use schemars::JsonSchema;
-use serde::{Deserialize, Serialize};
+pub use yarnhom_artifacts::membrane::{HingeBending, MembraneMaterial, Stiffening, StvkNeoHookean};
 use yarnhom_fit::{EnergyJet, SplineMaterial};
-
-/// The (6.1) parameters (J/m²): `k_xx, k_xy, k_yy, k_ss` of the StVK stiffness matrix on the
-/// Voigt Green strain `(E11, E22, 2 E12)`, and the Neo-Hookean area terms `k_n1 (J-1)²` and
-/// `k_n2 log² J`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct StvkNeoHookean {
-    /// Weft stiffness.
-    pub k_xx: f64,
-    /// Weft-warp coupling.
-    pub k_xy: f64,
-    /// Warp stiffness.
-    pub k_yy: f64,
-    /// Shear stiffness.
-    pub k_ss: f64,
-    /// `(J - 1)²` weight.
-    pub k_n1: f64,
-    /// `log² J` weight.
-    pub k_n2: f64,
-    /// Stiffening past an onset strain, if any (not part of (6.1)).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub stiffening: Option<Stiffening>,
-    /// Jamming past an onset compression, if any (not part of (6.1)): the same one-sided term
-    /// on the compressive Green strain, `½ k_weft ⟨-E11 - onset⟩₊² + ½ k_warp ⟨-E22 - onset⟩₊²`,
-    /// the shell-level analogue of the two-phase contact (6.7): the fabric contracts freely
-    /// across a pull while its yarns' soft outer contact layers give, and stiffly once they are
-    /// pressed onto the hard inner cores.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub jamming: Option<Stiffening>,
-}
-
-/// A biphasic membrane: `½ k_weft ⟨E11 - onset⟩₊² + ½ k_warp ⟨E22 - onset⟩₊²` added to (6.1),
-/// the shell-level analogue of the biphasic yarn stretch (6.5): the fabric stiffens once its
-/// Green strain along an axis passes `onset`. As [`StvkNeoHookean::jamming`] the same term
-/// acts on compression, `⟨-E - onset⟩₊`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-#[serde(deny_unknown_fields)]
-pub struct Stiffening {
-    /// Added stiffness along the weft past the onset (J/m²).
-    pub k_weft: f64,
-    /// Added stiffness along the warp past the onset (J/m²).
-    pub k_warp: f64,
-    /// Onset Green strain.
-    pub onset: f64,
-}
-
-/// The (6.4) bending stiffnesses `k_θ` (J) for bends across weft, bias and warp, and the rest
-/// curvatures `κ̄` (1/m) of a fabric that curls (0: flat at rest, the thesis' model).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct HingeBending {
-    /// Bending that curves the weft (X) direction.
-    pub k_weft: f64,
-    /// Bending at 45°.
-    pub k_bias: f64,
-    /// Bending that curves the warp (Y) direction.
-    pub k_warp: f64,
-    /// Rest curvature of the weft direction, positive towards the fabric's normal (1/m).
-    #[serde(default)]
-    pub rest_curvature_weft: f64,
-    /// Rest curvature at 45° (1/m).
-    #[serde(default)]
-    pub rest_curvature_bias: f64,
-    /// Rest curvature of the warp direction (1/m).
-    #[serde(default)]
-    pub rest_curvature_warp: f64,
-}
-
-impl Stiffening {
-    /// The same onset with a thousandth of the stiffness: where a nested fit starts the term,
-    /// so that the extended model starts where the model without it ended.
-    pub fn faint(self) -> Self {
-        Self { k_weft: 1e-3 * self.k_weft, k_warp: 1e-3 * self.k_warp, ..self }
-    }
-}
-
-impl HingeBending {
-    /// Flat at rest, the same stiffness `k` (J) in every direction.
-    pub fn isotropic(k: f64) -> Self {
-        Self::anisotropic(k, k, k)
-    }
-
-    /// Flat at rest, stiffnesses per direction (J).
-    pub fn anisotropic(k_weft: f64, k_bias: f64, k_warp: f64) -> Self {
-        Self {
-            k_weft,
-            k_bias,
-            k_warp,
-            rest_curvature_weft: 0.0,
-            rest_curvature_bias: 0.0,
-            rest_curvature_warp: 0.0,
-        }
-    }
-}
 
 /// The energy density of the forms.
 #[derive(Debug, Clone)]
@@ -142,7 +49,7 @@ impl ShellMaterial {
     pub fn jet(&self, first: [f64; 3], second: [f64; 3]) -> EnergyJet {
         match &self.forms {
             FormsEnergy::Spline(m) => m.jet(first, second),
-            FormsEnergy::Stvk(m) => m.jet(first),
+            FormsEnergy::Stvk(m) => membrane_jet(m, first),
         }
     }
 
@@ -150,7 +57,7 @@ impl ShellMaterial {
     pub fn energy_density(&self, first: [f64; 3], second: [f64; 3]) -> f64 {
         match &self.forms {
             FormsEnergy::Spline(m) => m.energy_density(first, second),
-            FormsEnergy::Stvk(m) => m.jet(first).value,
+            FormsEnergy::Stvk(m) => membrane_jet(m, first).value,
         }
     }
 
@@ -160,44 +67,58 @@ impl ShellMaterial {
     }
 }
 
-impl StvkNeoHookean {
-    /// (6.1) with derivatives in `(I11, I12, I22, ·, ·, ·)` (no dependence on `II`).
-    pub fn jet(&self, first: [f64; 3]) -> EnergyJet {
-        let [a, b, c] = first;
-        // Voigt Green strain ε = ((I11 - 1)/2, (I22 - 1)/2, I12), linear in I.
-        let eps = Vector3::new(0.5 * (a - 1.0), 0.5 * (c - 1.0), b);
-        let d_eps = Matrix3::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0);
-        let k = Matrix3::new(self.k_xx, self.k_xy, 0.0, self.k_xy, self.k_yy, 0.0, 0.0, 0.0, self.k_ss);
-        let stvk_gradient = d_eps.transpose() * k * eps;
-        let stvk_hessian = d_eps.transpose() * k * d_eps;
-        // J = sqrt(det I).
-        let det = a * c - b * b;
-        let j = det.max(1e-300).sqrt();
-        let d_det = Vector3::new(c, -2.0 * b, a);
-        let dd_det = Matrix3::new(0.0, 0.0, 1.0, 0.0, -2.0, 0.0, 1.0, 0.0, 0.0);
-        let d_j = d_det / (2.0 * j);
-        let dd_j = dd_det / (2.0 * j) - d_det * d_det.transpose() / (4.0 * j * j * j);
-        let log_j = j.ln();
-        let g = self.k_n1 * (j - 1.0).powi(2) + self.k_n2 * log_j * log_j;
-        let dg = 2.0 * self.k_n1 * (j - 1.0) + 2.0 * self.k_n2 * log_j / j;
-        let ddg = 2.0 * self.k_n1 + 2.0 * self.k_n2 * (1.0 - log_j) / (j * j);
-        let mut gradient = stvk_gradient + dg * d_j;
-        let mut hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
-        let mut one_sided = 0.0;
-        for (term, sign) in [(&self.stiffening, 1.0), (&self.jamming, -1.0)] {
-            if let Some(b) = term {
-                one_sided += add_one_sided_term(b, sign, &eps, &mut gradient, &mut hessian);
-            }
-        }
-        let mut jet = EnergyJet {
-            value: 0.5 * eps.dot(&(k * eps)) + g + one_sided,
-            gradient: Vector6::zeros(),
-            hessian: Default::default(),
-        };
-        jet.gradient.fixed_rows_mut::<3>(0).copy_from(&gradient);
-        jet.hessian.fixed_view_mut::<3, 3>(0, 0).copy_from(&hessian);
-        jet
+/// The shell material of a file: a spline (`.spline.yh` or another form of it, or an ARCSim-HYLC
+/// material JSON) or a Ch. 6 material JSON ([`MembraneMaterial`]).
+pub fn open_material(path: impl AsRef<std::path::Path>) -> Result<ShellMaterial, yarnhom_artifacts::Error> {
+    let path = path.as_ref();
+    let input = yarnhom_artifacts::open::open(path)?;
+    if let yarnhom_artifacts::open::Contents::Membrane(m) = input.contents {
+        return Ok(ShellMaterial::stvk(m.areal_density_kg_m2, m.membrane, m.bending));
     }
+    let (_, artifact) = input.into_artifact()?;
+    let spline = yarnhom_artifacts::Spline::try_from(artifact).map_err(|other| {
+        yarnhom_artifacts::Error::WrongKind { expected: "spline", found: other.kind().into() }.at(path)
+    })?;
+    Ok(ShellMaterial::spline(SplineMaterial::from(&spline)))
+}
+
+/// The membrane energy (6.1) of `m` with derivatives in `(I11, I12, I22, ·, ·, ·)` (no dependence
+/// on `II`).
+pub fn membrane_jet(m: &StvkNeoHookean, first: [f64; 3]) -> EnergyJet {
+    let [a, b, c] = first;
+    // Voigt Green strain ε = ((I11 - 1)/2, (I22 - 1)/2, I12), linear in I.
+    let eps = Vector3::new(0.5 * (a - 1.0), 0.5 * (c - 1.0), b);
+    let d_eps = Matrix3::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.5, 0.0, 1.0, 0.0);
+    let k = Matrix3::new(m.k_xx, m.k_xy, 0.0, m.k_xy, m.k_yy, 0.0, 0.0, 0.0, m.k_ss);
+    let stvk_gradient = d_eps.transpose() * k * eps;
+    let stvk_hessian = d_eps.transpose() * k * d_eps;
+    // J = sqrt(det I).
+    let det = a * c - b * b;
+    let j = det.max(1e-300).sqrt();
+    let d_det = Vector3::new(c, -2.0 * b, a);
+    let dd_det = Matrix3::new(0.0, 0.0, 1.0, 0.0, -2.0, 0.0, 1.0, 0.0, 0.0);
+    let d_j = d_det / (2.0 * j);
+    let dd_j = dd_det / (2.0 * j) - d_det * d_det.transpose() / (4.0 * j * j * j);
+    let log_j = j.ln();
+    let g = m.k_n1 * (j - 1.0).powi(2) + m.k_n2 * log_j * log_j;
+    let dg = 2.0 * m.k_n1 * (j - 1.0) + 2.0 * m.k_n2 * log_j / j;
+    let ddg = 2.0 * m.k_n1 + 2.0 * m.k_n2 * (1.0 - log_j) / (j * j);
+    let mut gradient = stvk_gradient + dg * d_j;
+    let mut hessian = stvk_hessian + ddg * d_j * d_j.transpose() + dg * dd_j;
+    let mut one_sided = 0.0;
+    for (term, sign) in [(&m.stiffening, 1.0), (&m.jamming, -1.0)] {
+        if let Some(b) = term {
+            one_sided += add_one_sided_term(b, sign, &eps, &mut gradient, &mut hessian);
+        }
+    }
+    let mut jet = EnergyJet {
+        value: 0.5 * eps.dot(&(k * eps)) + g + one_sided,
+        gradient: Vector6::zeros(),
+        hessian: Default::default(),
+    };
+    jet.gradient.fixed_rows_mut::<3>(0).copy_from(&gradient);
+    jet.hessian.fixed_view_mut::<3, 3>(0, 0).copy_from(&hessian);
+    jet
 }
 
 /// Add `½ k ⟨sign E - onset⟩₊²` on `E11` (`k_weft`) and `E22` (`k_warp`) to the derivatives in
@@ -234,16 +155,16 @@ mod tests {
             jamming: Some(Stiffening { k_weft: 4.0, k_warp: 3.0, onset: 0.02 }),
             ..crate::test_support::test_membrane()
         };
-        let rest = m.jet([1.0, 0.0, 1.0]);
+        let rest = membrane_jet(&m, [1.0, 0.0, 1.0]);
         assert!(rest.value.abs() < 1e-15 && rest.gradient.norm() < 1e-15);
         let first = [1.3, 0.2, 0.9];
-        let jet = m.jet(first);
+        let jet = membrane_jet(&m, first);
         let h = 1e-6;
         for j in 0..3 {
             let (mut p, mut q) = (first, first);
             p[j] += h;
             q[j] -= h;
-            let (jp, jq) = (m.jet(p), m.jet(q));
+            let (jp, jq) = (membrane_jet(&m, p), membrane_jet(&m, q));
             assert!((jet.gradient[j] - (jp.value - jq.value) / (2.0 * h)).abs() < 1e-7);
             for i in 0..3 {
                 assert!((jet.hessian[(i, j)] - (jp.gradient[i] - jq.gradient[i]) / (2.0 * h)).abs() < 1e-6);
@@ -255,7 +176,7 @@ mod tests {
     fn free_transverse_strain(m: &StvkNeoHookean, e11: f64) -> f64 {
         let mut i22 = 1.0;
         for _ in 0..50 {
-            let jet = m.jet([1.0 + 2.0 * e11, 0.0, i22]);
+            let jet = membrane_jet(m, [1.0 + 2.0 * e11, 0.0, i22]);
             i22 -= jet.gradient[2] / jet.hessian[(2, 2)];
         }
         0.5 * (i22 - 1.0)
@@ -296,7 +217,7 @@ mod tests {
             stiffening: None,
             jamming: None,
         };
-        let energy = |s: f64| m.jet([s * s, 0.0, 1.0]).value;
+        let energy = |s: f64| membrane_jet(&m, [s * s, 0.0, 1.0]).value;
         assert!(energy(1e-3) > energy(0.1) && energy(0.1) > energy(0.5));
     }
 }

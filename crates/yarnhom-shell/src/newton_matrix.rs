@@ -372,7 +372,9 @@ mod tests {
         use crate::material::{HingeBending, ShellMaterial};
         use crate::mesh::ShellMesh;
         let path = format!("{}/../../../shared/data/hylc-materials/stock1.json", env!("CARGO_MANIFEST_DIR"));
-        let spline = yarnhom_artifacts::arcsim::read_spline(std::path::Path::new(&path)).expect("published");
+        let spline = yarnhom_artifacts::open::open_artifact::<yarnhom_artifacts::Spline>(&path)
+            .expect("published")
+            .value;
         let stvk = crate::test_support::test_membrane();
         let materials = [
             ShellMaterial::spline(yarnhom_fit::SplineMaterial::from(&spline)),

@@ -25,6 +25,31 @@ pub struct FrameReport {
     pub penetration_m: f64,
 }
 
+/// Counts over the frames of a run, for its closing summary.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunTotals {
+    /// Time steps.
+    pub steps: u64,
+    /// Newton iterations over all steps.
+    pub newton_iterations: u64,
+    /// Conjugate-gradient iterations over all linear solves.
+    pub cg_iterations: u64,
+    /// Cholesky factorizations over all linear solves.
+    pub factorizations: u64,
+}
+
+impl RunTotals {
+    /// Adds a frame's steps.
+    pub fn add(&mut self, report: &FrameReport) {
+        for s in &report.steps {
+            self.steps += 1;
+            self.newton_iterations += u64::from(s.newton_iterations);
+            self.cg_iterations += u64::from(s.linear_solves.cg_iterations);
+            self.factorizations += u64::from(s.linear_solves.factorizations);
+        }
+    }
+}
+
 /// Why a run stopped.
 #[derive(Debug, thiserror::Error)]
 pub enum SimulateError {

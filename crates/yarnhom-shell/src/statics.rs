@@ -4,7 +4,7 @@
 //! no inertia, gravity or contact.
 
 use nalgebra::Vector3;
-use yarnhom_rve::linear::SpdSolver;
+use yarnhom_sparse::SpdSolver;
 
 use crate::elastic::{Assembly, ElasticModel, NewtonMatrix};
 use crate::line_search::backtrack;

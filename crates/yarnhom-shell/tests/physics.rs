@@ -3,7 +3,8 @@
 //! rests on a sphere without penetrating it. Coarse meshes and large steps keep them fast.
 
 use nalgebra::Vector3;
-use yarnhom_artifacts::arcsim::read_spline;
+use yarnhom_artifacts::Spline;
+use yarnhom_artifacts::open::open_artifact;
 use yarnhom_fit::SplineMaterial;
 use yarnhom_shell::elastic::NewtonMatrix;
 use yarnhom_shell::linear_solver::CG_ERROR_SHARE;
@@ -14,7 +15,7 @@ use yarnhom_shell::{LinearSolver, LinearSolves, Scene, ShellMaterial, Simulation
 fn published(name: &str) -> ShellMaterial {
     let path = format!("{}/../../../shared/data/hylc-materials/{name}.json", env!("CARGO_MANIFEST_DIR"));
     ShellMaterial::spline(SplineMaterial::from(
-        &read_spline(std::path::Path::new(&path)).expect("published material"),
+        &open_artifact::<Spline>(&path).expect("published material").value,
     ))
 }
 

@@ -9,6 +9,21 @@ pub enum TraceError {
     #[error("trace I/O error: {0}")]
     Io(#[from] std::io::Error),
 
+    /// A trace file could not be opened for reading.
+    #[error("cannot open the trace {path}: {source}")]
+    Open {
+        /// The file.
+        path: String,
+        /// What failed.
+        source: std::io::Error,
+    },
+
+    /// A binary trace was to be written to a terminal.
+    #[error(
+        "refusing to write a binary trace to the terminal: pipe it (`| yarnhom trace info`) or give a file"
+    )]
+    Terminal,
+
     /// The MCAP container is malformed or could not be written.
     #[error("MCAP error: {0}")]
     Mcap(#[source] mcap::McapError),

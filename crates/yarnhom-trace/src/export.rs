@@ -116,6 +116,7 @@ mod ply;
 #[cfg(test)]
 mod tests;
 
+pub use geometry::{boundary_triangles, check_tet_topology};
 pub use obj::{write_obj, write_obj_polylines};
 pub use ply::{write_ply, write_ply_polylines};
 
@@ -250,6 +251,12 @@ pub enum ExportError {
         /// What is wrong.
         problem: String,
     },
+
+    /// Writing an HDF5 dataset, group or attribute failed (the shared HDF5 layer of
+    /// `yarnhom-artifacts`).
+    #[cfg(feature = "hdf5")]
+    #[error(transparent)]
+    Hdf5Layer(#[from] yarnhom_artifacts::Error),
 
     /// The HDF5 library failed.
     #[cfg(feature = "hdf5")]

@@ -94,8 +94,7 @@ mod messages;
 mod metadata;
 mod reader;
 mod records;
-#[cfg(feature = "rerun")]
-pub mod rerun_log;
+mod sink;
 mod writer;
 
 pub use diff::{TopicDiff, TraceDiff, diff_traces};
@@ -107,7 +106,8 @@ pub use messages::{
 pub use metadata::{METADATA_NAME, TraceMetadata, read_metadata};
 pub use reader::{TraceMessage, TraceReader, decode};
 pub use records::{ReadProgress, RecordReader, TraceRecord};
-pub use writer::{AtomicFile, DEFAULT_CHUNK_SIZE, TraceWriter, TraceWriterOptions};
+pub use sink::{STDIO, TraceSink, is_stdio, open_records, open_source};
+pub use writer::{DEFAULT_CHUNK_SIZE, TraceWriter, TraceWriterOptions};
 
 /// Re-export of [`mcap::write::NoSeek`], the adapter used by [`TraceWriter::non_seeking`].
 pub use mcap::write::NoSeek;

@@ -1,16 +1,15 @@
 //! Writing traces.
 
 use std::collections::{BTreeMap, HashMap};
-use std::ffi::OsString;
-use std::fs::{self, File, OpenOptions};
-use std::io::{self, BufWriter, Seek, SeekFrom, Stdout, Write};
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::io::{self, BufWriter, Seek, Stdout, Write};
+use std::path::Path;
 
 use mcap::records::MessageHeader;
 use mcap::write::NoSeek;
 
 use crate::messages::{MESSAGE_ENCODING, SCHEMA_ENCODING, TOPIC_VERSION_KEY, Topic};
+use yarnhom_artifacts::AtomicFile;
+
 use crate::{TraceError, TraceMetadata};
 
 /// Default target size of an uncompressed chunk, in bytes (1 MiB, the MCAP library's default).
@@ -72,7 +71,7 @@ impl TraceWriterOptions {
         Ok(writer)
     }
 
-    /// Starts a trace on any seekable output (a [`File`], an [`io::Cursor`], ...).
+    /// Starts a trace on any seekable output (a [`std::fs::File`], an [`io::Cursor`], ...).
     pub fn seekable<W: Write + Seek>(&self, out: W) -> Result<TraceWriter<W>, TraceError> {
         TraceWriter::from_mcap_options(out, self.mcap_options(true))
     }
@@ -297,130 +296,6 @@ fn seconds_to_ns(topic: &'static str, time_s: f64) -> Result<u64, TraceError> {
         Ok(ns as u64)
     } else {
         Err(TraceError::InvalidTime { topic, time_s })
-    }
-}
-
-/// A trace file being written atomically by [`TraceWriter::create`].
-///
-/// Bytes go to a hidden temporary file next to the destination. [`TraceWriter::finish`] flushes
-/// it, syncs it to disk and renames it over the destination; if it is dropped before that, the
-/// temporary file is deleted.
-#[derive(Debug)]
-pub struct AtomicFile {
-    /// `None` once committed (or after a failed commit).
-    file: Option<BufWriter<File>>,
-    temp_path: PathBuf,
-    final_path: PathBuf,
-    committed: bool,
-}
-
-impl AtomicFile {
-    fn create(final_path: &Path) -> io::Result<Self> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let file_name = final_path.file_name().ok_or_else(|| {
-            io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!("trace path {} has no file name", final_path.display()),
-            )
-        })?;
-        let dir = match final_path.parent() {
-            Some(dir) if !dir.as_os_str().is_empty() => dir,
-            _ => Path::new("."),
-        };
-        loop {
-            let mut temp_name = OsString::from(".");
-            temp_name.push(file_name);
-            temp_name.push(format!(
-                ".{}-{}.tmp",
-                std::process::id(),
-                COUNTER.fetch_add(1, Ordering::Relaxed)
-            ));
-            let temp_path = dir.join(temp_name);
-            match OpenOptions::new().write(true).create_new(true).open(&temp_path) {
-                Ok(file) => {
-                    return Ok(Self {
-                        file: Some(BufWriter::new(file)),
-                        temp_path,
-                        final_path: final_path.to_path_buf(),
-                        committed: false,
-                    });
-                }
-                // A leftover from an earlier process with the same id: try the next name.
-                Err(err) if err.kind() == io::ErrorKind::AlreadyExists => continue,
-                Err(err) => return Err(err),
-            }
-        }
-    }
-
-    /// The destination path of the trace.
-    pub fn path(&self) -> &Path {
-        &self.final_path
-    }
-
-    /// Whether the trace has been moved into place.
-    pub fn is_committed(&self) -> bool {
-        self.committed
-    }
-
-    fn file(&mut self) -> io::Result<&mut BufWriter<File>> {
-        self.file.as_mut().ok_or_else(|| io::Error::other("the trace file is already closed"))
-    }
-
-    /// Flushes, syncs and closes the temporary file, then renames it to the destination.
-    fn commit(&mut self) -> io::Result<()> {
-        let file = self.file.take().ok_or_else(|| io::Error::other("the trace file is already closed"))?;
-        let file = file.into_inner().map_err(io::IntoInnerError::into_error)?;
-        file.sync_all()?;
-        drop(file);
-        fs::rename(&self.temp_path, &self.final_path)?;
-        self.committed = true;
-        // Make the rename itself durable; some file systems refuse to sync a directory, and
-        // the trace is complete either way, so this is best effort.
-        #[cfg(unix)]
-        if let Some(dir) = self.final_path.parent() {
-            let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
-            if let Ok(dir) = File::open(dir) {
-                let _ = dir.sync_all();
-            }
-        }
-        Ok(())
-    }
-}
-
-impl Write for AtomicFile {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.file()?.write(buf)
-    }
-
-    fn write_all(&mut self, buf: &[u8]) -> io::Result<()> {
-        self.file()?.write_all(buf)
-    }
-
-    fn flush(&mut self) -> io::Result<()> {
-        match self.file.as_mut() {
-            Some(file) => file.flush(),
-            None => Ok(()),
-        }
-    }
-}
-
-impl Seek for AtomicFile {
-    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
-        self.file()?.seek(pos)
-    }
-
-    fn stream_position(&mut self) -> io::Result<u64> {
-        self.file()?.stream_position()
-    }
-}
-
-impl Drop for AtomicFile {
-    fn drop(&mut self) {
-        if !self.committed {
-            // Close before deleting (required on Windows); errors cannot be reported here.
-            drop(self.file.take());
-            let _ = fs::remove_file(&self.temp_path);
-        }
     }
 }
 

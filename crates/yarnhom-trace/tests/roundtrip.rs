@@ -97,7 +97,7 @@ fn file_round_trip_is_atomic_and_identical() {
     assert_eq!(std::fs::read_dir(&dir).expect("ls").count(), 1, "one temp file");
     let file = writer.finish().expect("finish");
     assert!(file.is_committed());
-    assert_eq!(file.path(), path);
+    assert_eq!(file.destination(), path);
     assert_eq!(std::fs::read_dir(&dir).expect("ls").count(), 1, "the temp file was renamed, not copied");
 
     let read = read_all(std::fs::File::open(&path).expect("open"));

@@ -3,63 +3,76 @@
 use ::hdf5::Group;
 use ::hdf5::types::VarLenUnicode;
 
-use super::{Spec, create_group, has_attr, read_dataset, read_str_attr, read_u32_attr, rows, varlen};
-use super::{write_dataset, write_str_attr, write_u32_attr};
+use super::layer::{Spec, create_group, varlen, write_str_attr, write_u32_attr};
+use super::{DatasetSpec, has_attr, read_dataset, read_str_attr, read_u32_attr, rows, write_dataset};
 use crate::Artifact;
 use crate::error::{Error, Result, ValidationError};
 use crate::grid::{Grid, GridSample, GridShard, GridTerm, strain_from_values, strain_values};
 
-const TERM_LENGTHS: Spec = Spec {
+const TERM_LENGTHS: DatasetSpec = DatasetSpec {
     path: "/terms/lengths",
-    units: "1",
-    description: "number of sampled values of each term's axes; the second is 0 for a 1D term",
+    spec: Spec {
+        units: "1",
+        description: "number of sampled values of each term's axes; the second is 0 for a 1D term",
+    },
 };
-const TERM_VALUES: Spec = Spec {
+const TERM_VALUES: DatasetSpec = DatasetSpec {
     path: "/terms/values",
-    units: "1 (sx, sa, sy) or 1/m (kx, ky)",
-    description: "the sampled values of every term's axes, term by term, axis by axis (split by /terms/lengths)",
+    spec: Spec {
+        units: "1 (sx, sa, sy) or 1/m (kx, ky)",
+        description: "the sampled values of every term's axes, term by term, axis by axis (split by /terms/lengths)",
+    },
 };
-const TERM_AXES: Spec = Spec {
+const TERM_AXES: DatasetSpec = DatasetSpec {
     path: "/terms/axes",
-    units: "1",
-    description: "axis indices (0 sx, 1 sa, 2 sy, 3 kx, 4 ky) of each term; the second is -1 for a 1D term",
+    spec: Spec {
+        units: "1",
+        description: "axis indices (0 sx, 1 sa, 2 sy, 3 kx, 4 ky) of each term; the second is -1 for a 1D term",
+    },
 };
-const TERM: Spec =
-    Spec { path: "/samples/term", units: "1", description: "term of each sample (row of /terms/axes)" };
-const INDEX: Spec = Spec {
+const TERM: DatasetSpec = DatasetSpec {
+    path: "/samples/term",
+    spec: Spec { units: "1", description: "term of each sample (row of /terms/axes)" },
+};
+const INDEX: DatasetSpec = DatasetSpec {
     path: "/samples/index",
-    units: "1",
-    description: "indices into the values of the term's axes; the second is 0 for a 1D term",
+    spec: Spec {
+        units: "1",
+        description: "indices into the values of the term's axes; the second is 0 for a 1D term",
+    },
 };
-const STRAIN: Spec = Spec {
+const STRAIN: DatasetSpec = DatasetSpec {
     path: "/samples/strain",
-    units: "1, 1, 1, 1/m, 1/m",
-    description: "imposed strain, columns sx, sa, sy, kx, ky",
+    spec: Spec { units: "1, 1, 1, 1/m, 1/m", description: "imposed strain, columns sx, sa, sy, kx, ky" },
 };
-const CONVERGED: Spec =
-    Spec { path: "/samples/converged", units: "1", description: "1 if the equilibrium was found, else 0" };
-const STOP_REASON: Spec =
-    Spec { path: "/samples/stop_reason", units: "1", description: "why the solver stopped" };
-const ENERGY: Spec = Spec {
+const CONVERGED: DatasetSpec = DatasetSpec {
+    path: "/samples/converged",
+    spec: Spec { units: "1", description: "1 if the equilibrium was found, else 0" },
+};
+const STOP_REASON: DatasetSpec = DatasetSpec {
+    path: "/samples/stop_reason",
+    spec: Spec { units: "1", description: "why the solver stopped" },
+};
+const ENERGY: DatasetSpec = DatasetSpec {
     path: "/samples/energy_density_j_m2",
-    units: "J/m^2",
-    description: "homogenized energy density (3.22); NaN where not converged",
+    spec: Spec { units: "J/m^2", description: "homogenized energy density (3.22); NaN where not converged" },
 };
-const STRESS: Spec = Spec {
+const STRESS: DatasetSpec = DatasetSpec {
     path: "/samples/stress",
-    units: "J/m^2, J/m^2, J/m^2, J/m, J/m",
-    description: "homogenized stress (3.23c), derivatives by sx, sa, sy, kx, ky; NaN rows where absent",
+    spec: Spec {
+        units: "J/m^2, J/m^2, J/m^2, J/m, J/m",
+        description: "homogenized stress (3.23c), derivatives by sx, sa, sy, kx, ky; NaN rows where absent",
+    },
 };
-const ITERATIONS: Spec = Spec { path: "/samples/iterations", units: "1", description: "Newton iterations" };
-const POSITIONS: Spec = Spec {
+const ITERATIONS: DatasetSpec =
+    DatasetSpec { path: "/samples/iterations", spec: Spec { units: "1", description: "Newton iterations" } };
+const POSITIONS: DatasetSpec = DatasetSpec {
     path: "/samples/positions_m",
-    units: "m",
-    description: "equilibrium yarn centreline vertices of each sample's tile",
+    spec: Spec { units: "m", description: "equilibrium yarn centreline vertices of each sample's tile" },
 };
-const TWISTS: Spec = Spec {
+const TWISTS: DatasetSpec = DatasetSpec {
     path: "/samples/edge_twist_rad",
-    units: "rad",
-    description: "equilibrium edge twists of each sample, by source vertex",
+    spec: Spec { units: "rad", description: "equilibrium edge twists of each sample, by source vertex" },
 };
 
 pub(super) fn write_grid(root: &Group, g: &Grid) -> Result<()> {

@@ -1,13 +1,15 @@
 //! Per-frame OBJ and PLY files.
 
 use std::collections::HashMap;
-use std::fs::{self, File};
-use std::io::{self, BufWriter, Write};
+use std::fs;
+use std::io;
 use std::path::{Path, PathBuf};
 
 use super::geometry::{
     boundary_triangles, check_indices, check_tet_topology, check_vertex_count, check_yarn_frame, file_stem,
 };
+use yarnhom_artifacts::AtomicFile;
+
 use super::{ExportError, ExportStats, FrameFormat, obj, ply};
 use crate::{MeshFrame, MeshTopology, TetFrame, TetTopology, TraceMessage, YarnFrame};
 
@@ -135,31 +137,14 @@ impl<'a> FrameWriter<'a> {
     }
 }
 
-/// Writes a file through a hidden temporary file in the same folder, renamed into place once
-/// complete, so that a failed write leaves no partial file.
+/// Writes a file atomically ([`AtomicFile`]): a failed write leaves no partial file.
 fn write_atomically(
     path: &Path,
-    fill: impl FnOnce(&mut BufWriter<File>) -> io::Result<()>,
+    fill: impl FnOnce(&mut AtomicFile) -> io::Result<()>,
 ) -> Result<(), ExportError> {
-    let error = |error| ExportError::Write { path: path.to_path_buf(), error };
-    let temp = temp_path(path);
-    let written = File::create(&temp).and_then(|file| {
-        let mut out = BufWriter::new(file);
-        fill(&mut out)?;
-        out.flush()
+    let written = AtomicFile::create(path).and_then(|mut file| {
+        fill(&mut file)?;
+        file.commit()
     });
-    match written.and_then(|()| fs::rename(&temp, path)) {
-        Ok(()) => Ok(()),
-        Err(source) => {
-            // The temporary file may not exist; its removal is best effort.
-            let _ = fs::remove_file(&temp);
-            Err(error(source))
-        }
-    }
-}
-
-/// `.<file name>.tmp` next to `path`.
-fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|name| name.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp"))
+    written.map_err(|error| ExportError::Write { path: path.to_path_buf(), error })
 }

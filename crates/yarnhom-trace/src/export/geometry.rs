@@ -19,7 +19,7 @@ pub(super) fn check_indices<const N: usize>(
 }
 
 /// Checks a tet topology: vertex indices in range, one value per tetrahedron.
-pub(super) fn check_tet_topology(topology: &TetTopology) -> Result<(), String> {
+pub fn check_tet_topology(topology: &TetTopology) -> Result<(), String> {
     check_indices(&topology.tets, topology.rest_positions_m.len(), "tetrahedron")?;
     let tets = topology.tets.len();
     match topology.element_values.iter().find(|(_, values)| values.len() != tets) {
@@ -63,7 +63,7 @@ pub(super) fn check_yarn_frame(frame: &YarnFrame) -> Result<(), String> {
 /// The triangles of a tet mesh that belong to one tetrahedron only, oriented so that their
 /// normals (counter-clockwise) point out of the mesh, in the order of their tetrahedra.
 /// Tetrahedra negatively oriented at rest are turned around first. Indices must be in range.
-pub(super) fn boundary_triangles(tets: &[[u32; 4]], rest_positions: &[[f64; 3]]) -> Vec<[u32; 3]> {
+pub fn boundary_triangles(tets: &[[u32; 4]], rest_positions: &[[f64; 3]]) -> Vec<[u32; 3]> {
     let faces: Vec<[u32; 3]> = tets.iter().flat_map(|&tet| outward_faces(tet, rest_positions)).collect();
     let mut count: HashMap<[u32; 3], u32> = HashMap::with_capacity(faces.len());
     for face in &faces {

@@ -1,13 +1,15 @@
 //! The HDF5 export (see the [module docs](super) for the layout).
 
 use std::collections::{BTreeMap, HashMap};
-use std::fs;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 
 use ::hdf5::types::{TypeDescriptor, VarLenUnicode};
-use ::hdf5::{Dataset, Extent, File, Group, H5Type, Location};
+use ::hdf5::{Dataset, Extent, File, Group, H5Type};
 use serde::Serialize;
+use yarnhom_artifacts::AtomicFile;
+use yarnhom_artifacts::hdf5::layer::{
+    Spec, create_group, describe, open_or_create_group, varlen, write_str_attr,
+};
 
 use super::geometry::{
     boundary_triangles, check_indices, check_tet_topology, check_vertex_count, check_yarn_frame, link_name,
@@ -40,7 +42,7 @@ pub(super) struct Hdf5Writer {
     streams: Streams,
     catalog: Catalog,
     file: File,
-    temp: TempFile,
+    temp: AtomicFile,
 }
 
 /// The streams met so far, each with its open datasets.
@@ -58,12 +60,16 @@ struct Streams {
 impl Hdf5Writer {
     /// Starts an export to `path`: an empty HDF5 file is created next to it.
     pub(super) fn create(path: &Path) -> Result<Self, ExportError> {
-        let temp = TempFile::next_to(path)?;
+        let temp = AtomicFile::create(path)
+            .map_err(|error| ExportError::Write { path: path.to_path_buf(), error })?;
         let file = File::with_options()
             .with_fcpl(|fcpl| fcpl.obj_track_times(false))
-            .create_excl(&temp.path)
+            .create(temp.temp_path())
             .map_err(|e| {
-                h5_error(format!("cannot create {} (to become {})", temp.path.display(), path.display()), e)
+                h5_error(
+                    format!("cannot create {} (to become {})", temp.temp_path().display(), path.display()),
+                    e,
+                )
             })?;
         Ok(Self { streams: Streams::default(), catalog: Catalog::default(), file, temp })
     }
@@ -94,7 +100,7 @@ impl Hdf5Writer {
     /// Writes the RVE term names, the root attributes and the manifest, then closes the file
     /// and moves it into place.
     pub(super) fn finish(self, input_name: &str, stats: &mut ExportStats) -> Result<(), ExportError> {
-        let Self { streams, mut catalog, file, temp } = self;
+        let Self { streams, mut catalog, file, mut temp } = self;
         if let Some(rve) = &streams.rve {
             rve.write_term_names(&mut catalog)?;
         }
@@ -112,8 +118,9 @@ impl Hdf5Writer {
             datasets: catalog.entries_with_shapes(&file)?,
         };
         write_manifest(&file, &manifest)?;
-        file.close().map_err(|e| h5_error(format!("cannot close {}", temp.path.display()), e))?;
-        temp.commit()?;
+        file.close().map_err(|e| h5_error(format!("cannot close {}", temp.temp_path().display()), e))?;
+        let destination = temp.destination().to_path_buf();
+        temp.commit().map_err(|error| ExportError::Write { path: destination, error })?;
         stats.files_written += 1;
         Ok(())
     }
@@ -560,12 +567,6 @@ impl Table {
 // ---------------------------------------------------------------------------------------------
 // Datasets
 
-/// The `units` and `description` attributes of a dataset.
-struct Spec {
-    units: &'static str,
-    description: &'static str,
-}
-
 const POSITIONS: Spec =
     Spec { units: "m", description: "vertex positions of each frame, in the vertex order of the topology" };
 const FRAME: Spec = Spec { units: "1", description: "frame number of each row, on its producer's clock" };
@@ -761,8 +762,7 @@ impl Catalog {
         path: String,
         spec: &Spec,
     ) -> Result<(), ExportError> {
-        write_str_attr(dataset, "units", spec.units)?;
-        write_str_attr(dataset, "description", spec.description)?;
+        describe(dataset, spec)?;
         let dtype = match T::type_descriptor() {
             TypeDescriptor::VarLenUnicode => "string".to_owned(),
             other => other.to_string(),
@@ -842,39 +842,6 @@ impl Column {
     }
 }
 
-fn create_group(parent: &Group, name: &str) -> Result<Group, ExportError> {
-    let path = format!("{}/{name}", parent.name().trim_end_matches('/'));
-    parent
-        .create_group_builder()
-        .obj_track_times(false)
-        .create(name)
-        .map_err(|e| h5_error(format!("cannot create the group {path}"), e))
-}
-
-fn open_or_create_group(parent: &Group, name: &str) -> Result<Group, ExportError> {
-    if parent.link_exists(name) {
-        parent.group(name).map_err(|e| h5_error(format!("cannot open the group /{name}"), e))
-    } else {
-        create_group(parent, name)
-    }
-}
-
-/// A string as HDF5 variable-length UTF-8 (which cannot hold NUL characters).
-fn varlen(what: &str, value: &str) -> Result<VarLenUnicode, ExportError> {
-    value.parse().map_err(|e| {
-        h5_error(format!("cannot store {what} {value:?} as an HDF5 string"), format!("{e}").into())
-    })
-}
-
-fn write_str_attr(location: &Location, name: &str, value: &str) -> Result<(), ExportError> {
-    let value = varlen(&format!("the attribute {name:?}"), value)?;
-    location
-        .new_attr::<VarLenUnicode>()
-        .create(name)
-        .and_then(|attr| attr.write_scalar(&value))
-        .map_err(|e| h5_error(format!("cannot write the attribute {name:?}"), e))
-}
-
 // ---------------------------------------------------------------------------------------------
 // Manifest
 
@@ -918,57 +885,5 @@ fn write_manifest(file: &File, manifest: &Manifest<'_>) -> Result<(), ExportErro
         .create("manifest")
         .map_err(|e| h5_error("cannot create /manifest".into(), e))?;
     dataset.write_scalar(&text).map_err(|e| h5_error("cannot write /manifest".into(), e))?;
-    write_str_attr(&dataset, "units", MANIFEST.units)?;
-    write_str_attr(&dataset, "description", MANIFEST.description)
-}
-
-// ---------------------------------------------------------------------------------------------
-// Atomic file
-
-/// The temporary file an export is written to, next to its destination; deleted when dropped
-/// unless committed.
-struct TempFile {
-    path: PathBuf,
-    destination: PathBuf,
-    committed: bool,
-}
-
-impl TempFile {
-    /// A fresh name `.<file name>.<pid>-<n>.tmp` in the destination's folder.
-    fn next_to(destination: &Path) -> Result<Self, ExportError> {
-        static COUNTER: AtomicU64 = AtomicU64::new(0);
-        let name = destination.file_name().ok_or_else(|| ExportError::Write {
-            path: destination.to_path_buf(),
-            error: std::io::Error::new(std::io::ErrorKind::InvalidInput, "the path has no file name"),
-        })?;
-        let temp_name = format!(
-            ".{}.{}-{}.tmp",
-            name.to_string_lossy(),
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        );
-        Ok(Self {
-            path: destination.with_file_name(temp_name),
-            destination: destination.to_path_buf(),
-            committed: false,
-        })
-    }
-
-    /// Syncs the closed temporary file and renames it to the destination.
-    fn commit(mut self) -> Result<(), ExportError> {
-        let error = |error| ExportError::Write { path: self.destination.clone(), error };
-        fs::File::open(&self.path).and_then(|file| file.sync_all()).map_err(error)?;
-        fs::rename(&self.path, &self.destination).map_err(error)?;
-        self.committed = true;
-        Ok(())
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if !self.committed {
-            // Nothing can be reported from a drop; the file may not even exist.
-            let _ = fs::remove_file(&self.path);
-        }
-    }
+    Ok(describe(&dataset, &MANIFEST)?)
 }

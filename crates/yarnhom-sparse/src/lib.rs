@@ -1,9 +1,4 @@
-//! Sparse symmetric positive definite solves with faer, on a symbolic Cholesky analysis that is
-//! kept for a sparsity pattern that only grows. A matrix whose nonzeros lie inside the analysed
-//! pattern is factored on it (the entries it lacks are explicit zeros); one with an entry outside
-//! it triggers the analysis of the union of both patterns. In a tile solve the pattern changes
-//! only when contact pairs appear or vanish (A.2.3), so an analysis is needed only the first time
-//! a pair of edges meets.
+#![doc = include_str!("../README.md")]
 
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, SymbolicLlt};

@@ -1,20 +1,4 @@
-//! Turning traces into [rerun](https://rerun.io) recordings (feature `rerun`).
-//!
-//! | topic | rerun entity | archetype |
-//! |---|---|---|
-//! | `/mesh/topology` | `mesh/<name>` | [`Mesh3D`] triangle indices (static) |
-//! | `/mesh/frame` | `mesh/<name>` | [`Mesh3D`] vertex positions and normals |
-//! | `/yarn/frame` | `yarns/<name>` | [`LineStrips3D`], one strip per yarn, radius = the yarn's mean radius |
-//! | `/tet/topology` | `tet/<name>` | [`Mesh3D`] boundary triangles (static) |
-//! | `/tet/frame` | `tet/<name>` | [`Mesh3D`] vertex positions |
-//! | `/metrics` | `metrics/<value name>` | [`Scalars`] |
-//! | `/solver` | `solver/<field>` | [`Scalars`] |
-//! | `/solver/iteration` | `solver/iteration/<field>` | [`Scalars`] |
-//! | `/rve/sample` | `rve/<term>/energy_density_j_m2` | [`Scalars`] (converged samples) |
-//!
-//! Every message is logged on two timelines: `frame` (the message's `frame` field, the index on
-//! its producer's clock) and `sim_time` (its `time_s`, seconds). Positions are converted to
-//! `f32`, as rerun stores them.
+#![doc = include_str!("../README.md")]
 
 use std::collections::HashMap;
 use std::io::Read;
@@ -22,7 +6,8 @@ use std::io::Read;
 pub use rerun;
 use rerun::{LineStrips3D, Mesh3D, RecordingStream, Scalars};
 
-use crate::{
+use yarnhom_trace::export::{boundary_triangles, check_tet_topology};
+use yarnhom_trace::{
     MeshFrame, MeshTopology, RveSample, SolverIteration, SolverStep, TetFrame, TetTopology, TraceError,
     TraceMessage, TraceReader, Truncation, YarnFrame,
 };
@@ -46,6 +31,14 @@ pub enum RerunLogError {
         mesh: String,
         /// Frame number.
         frame: u64,
+    },
+    /// A tet mesh's topology indexes past its vertices.
+    #[error("/tet/topology: tet mesh '{mesh}': {problem}")]
+    InvalidTopology {
+        /// Mesh name.
+        mesh: String,
+        /// What is wrong.
+        problem: String,
     },
 }
 
@@ -117,7 +110,9 @@ impl<'a> RerunLogger<'a> {
     }
 
     fn log_tet_topology(&mut self, m: &TetTopology) -> Result<(), RerunLogError> {
-        let boundary = boundary_triangles(&m.tets);
+        check_tet_topology(m)
+            .map_err(|problem| RerunLogError::InvalidTopology { mesh: m.name.clone(), problem })?;
+        let boundary = boundary_triangles(&m.tets, &m.rest_positions_m);
         self.rec.log_static(
             format!("tet/{}", m.name),
             &Mesh3D::update_fields().with_triangle_indices(boundary.clone()),
@@ -249,23 +244,6 @@ fn vertex_normals(positions_m: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f32;
         .collect()
 }
 
-/// The faces of a tetrahedral mesh that belong to one tetrahedron only, oriented outwards
-/// (for positively oriented tetrahedra).
-fn boundary_triangles(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
-    let mut faces: HashMap<[u32; 3], ([u32; 3], u32)> = HashMap::new();
-    for &[a, b, c, d] in tets {
-        for face in [[a, c, b], [a, b, d], [a, d, c], [b, c, d]] {
-            let mut key = face;
-            key.sort_unstable();
-            faces.entry(key).or_insert((face, 0)).1 += 1;
-        }
-    }
-    let mut boundary: Vec<[u32; 3]> =
-        faces.into_values().filter(|&(_, count)| count == 1).map(|(face, _)| face).collect();
-    boundary.sort_unstable();
-    boundary
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -274,7 +252,7 @@ mod tests {
     fn two_tets_sharing_a_face_have_six_boundary_faces_facing_out() {
         let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 1.0, 1.0]];
         let tets = [[0, 1, 2, 3], [1, 2, 3, 4]];
-        let boundary = boundary_triangles(&tets);
+        let boundary = boundary_triangles(&tets, &positions);
         assert_eq!(boundary.len(), 6);
         let centroid = |ids: &[u32]| {
             let mut c = [0.0; 3];
