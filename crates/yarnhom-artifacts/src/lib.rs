@@ -1,15 +1,4 @@
-//! yarnhom's artifacts: every file a yarnhom stage reads or writes.
-//!
-//! - [`container`]: the versioned `.yh` framing shared by every kind (magic, header, zstd
-//!   msgpack payload, checksum), atomic writes, migrations of older schema versions.
-//! - Kinds: [`pattern::Pattern`] (`pattern`), [`yarnmodel::YarnModel`] (`yarnmodel`),
-//!   [`rvesolve::RveSolve`] (`rvesolve`), [`grid::Grid`] (`grid`), [`spline::Spline`] (`spline`).
-//! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
-//! - [`open`]: the one way to open an input, recognised by content.
-//! - [`membrane`]: the Ch. 6 shell material's parameters and its JSON file.
-//! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
-//! - [`schema`]: JSON Schemas generated from the types.
-//! - [`atomic`]: the one way yarnhom writes a file (temporary file, sync, rename, mode kept).
+#![doc = include_str!("../README.md")]
 
 pub mod arcsim;
 pub mod atomic;

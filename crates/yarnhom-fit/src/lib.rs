@@ -1,20 +1,4 @@
-//! Homogenized yarn-level cloth materials (thesis Ch. 4, App. A.3-A.5, B).
-//!
-//! - [`fit`]: a sampled grid into a spline material (Algorithms 3-5).
-//! - [`mls`]: moving least squares in symlog space (A.35).
-//! - [`monotone_cubic`], [`monotone_bicubic`]: monotone Hermite interpolation (Fritsch-Carlson
-//!   1980; App. B).
-//! - [`march`]: quasiconvex marching (A.36) and increasing extrapolation (A.3.5).
-//! - [`residual`]: residualization (A.37, A.38).
-//! - [`shape`]: single-minimum checks of the fitted terms (A.36).
-//! - [`ranges`]: the strain ranges a fitted material was sampled over, from its control points.
-//! - [`compare`]: two materials' 1D terms compared over the strains both were fitted on.
-//! - [`hermite`]: cubic and bicubic Hermite splines with derivatives and linear extrapolation.
-//! - [`curvature`]: the curvature split (A.39)-(A.41), smooth at umbilics.
-//! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
-//! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
-//! - [`difference`]: two spline materials compared by their energies and stresses on a dense
-//!   strain plan (`yarnhom diff`).
+#![doc = include_str!("../README.md")]
 
 pub mod compare;
 pub mod curvature;

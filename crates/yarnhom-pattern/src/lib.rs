@@ -1,11 +1,4 @@
-//! Built-in yarn pattern generators and pattern geometry queries.
-//!
-//! Generators produce plausible, non-self-intersecting starting states for relaxation: smooth
-//! centrelines, near-uniform edges, crossing yarns `2 * 1.5` radii apart at the crossings, and
-//! nowhere closer than [`MIN_CLEARANCE_R`] = 1.9 radii: [`generate`] measures every pattern with
-//! [`min_inter_yarn_distance`] and refuses one that comes closer (a stitch or tessellation too
-//! coarse for its loops). Knits (see [`knit`]): `stockinette`, `garter`, `rib` (1x1), `seed`.
-//! Weaves (see [`weave`]): `plain`, `basket` (2x2), `satin` (5-harness).
+#![doc = include_str!("../README.md")]
 
 mod curve;
 pub mod knit;

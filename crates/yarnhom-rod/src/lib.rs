@@ -1,12 +1,4 @@
-//! Yarn mechanics as element energies with exact gradients and Hessians.
-//!
-//! - [`stretch`]: edge stretching, linear (discrete elastic rods) and biphasic (6.5);
-//! - [`bend_twist`]: bending and twisting of discrete elastic rods (Bergou et al. 2008, 2010)
-//!   with rest curvature and twist, `γ`-scaled stiffness (3.25) or isotropic `k_b` (6.6);
-//! - [`frames`]: parallel transport and time-parallel reference frames;
-//! - [`contact`]: yarn-yarn contact between edges, Kaldor et al. (2008) and the two-phase
-//!   barrier (6.7);
-//! - [`rod`]: one open or closed rod assembled from the stretch and bend-twist elements.
+#![doc = include_str!("../README.md")]
 
 pub mod bend_twist;
 pub mod contact;
