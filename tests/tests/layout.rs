@@ -151,6 +151,6 @@ fn the_cli_is_thin() {
 #[test]
 fn the_function_measure_counts_from_fn_to_its_closing_brace() {
     let text = "fn short() {\n    1;\n}\n\npub fn long() {\n    a();\n    b();\n}\n";
-    assert_eq!(long_functions(text, 2), vec![("long".to_string(), 4)]);
+    assert_eq!(long_functions(text, 3), vec![("long".to_string(), 4)]);
     assert!(long_functions(text, 4).is_empty());
 }

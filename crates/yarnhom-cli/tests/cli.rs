@@ -749,7 +749,7 @@ fn diff_of_a_missing_file_or_of_other_kinds_exits_2() {
     ok(&["model", "write", "table4.1:stock", "-o", "m.yarnmodel.yh"], d);
     fails_with(&["diff", pattern, "m.yarnmodel.yh"], d, "cannot compare a 'pattern'");
     std::fs::write(d.join("fake.mcap"), b"not a trace").expect("write");
-    fails_with(&["diff", "fake.mcap", "fake.mcap"], d, "not an MCAP trace");
+    fails_with(&["diff", "fake.mcap", "fake.mcap"], d, "or MCAP trace");
     ok(&["fit", "import-arcsim", &format!("{MATERIALS}/satin1.json"), "-o", "satin.spline.yh"], d);
     ok(
         &[
