@@ -12,11 +12,13 @@
 //! - [`curvature`]: the curvature split (A.39)-(A.41), smooth at umbilics.
 //! - [`synthetic`]: a synthetic thesis-shaped grid of a known energy, for tests.
 //! - [`material`]: the spline material `Ψ(I, II)` (4.3), (A.34) with exact derivatives.
+//! - [`figures`]: the figures of a fit against its grid (Fig. 4.4, 4.5) as `yarnhom_figures` data.
 //! - [`difference`]: two spline materials compared by their energies and stresses on a dense
 //!   strain plan (`yarnhom diff`).
 
 pub mod curvature;
 pub mod difference;
+pub mod figures;
 pub mod fit;
 pub mod hermite;
 pub mod march;

@@ -29,15 +29,9 @@ const MIN_EIGENVALUE_RATIO: f64 = 1e-10;
 /// The stencil stays well inside the neighbouring intervals.
 pub const FD_STEP_FRACTION: f64 = 0.1;
 
-/// `sgn(x) ln(|x| + 1)` (App. A.3.3).
-pub fn symlog(x: f64) -> f64 {
-    x.signum() * x.abs().ln_1p()
-}
-
-/// `sgn(x) (exp(|x|) - 1)`, the inverse of [`symlog`] (App. A.3.3).
-pub fn symexp(x: f64) -> f64 {
-    x.signum() * x.abs().exp_m1()
-}
+/// The symmetric logarithm of App. A.3.3, the space of the smoothing, and its inverse: one
+/// definition for the fit and the colour scales of its figures (Fig. 4.5).
+pub use yarnhom_figures::{symexp, symlog};
 
 /// The Wendland C² weight `(1 - r/R)⁴ (4 r/R + 1)` for `r < R`, else 0.
 pub fn wendland(r: f64, radius: f64) -> f64 {
