@@ -292,7 +292,10 @@ fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
     let spline = load_spline(&args.spline)?;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create {}", args.output.display()))?;
-    for path in crate::fit_plot::plot_fit(&grid, &spline, &args.output)? {
+    for (file, figure) in yarnhom_fit::figures::fit_figures(&grid, &spline) {
+        let path = args.output.join(file);
+        std::fs::write(&path, yarnhom_figures::render_svg(&figure)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
         println!("wrote {}", path.display());
     }
     Ok(Outcome::Success)

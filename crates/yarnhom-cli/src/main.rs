@@ -9,7 +9,6 @@ mod calibrate_yarn;
 mod convert;
 mod diff;
 mod fit;
-mod fit_plot;
 mod grid;
 mod inputs;
 mod inspect;
