@@ -9,6 +9,7 @@
 pub mod bending_fit;
 pub mod cantilever;
 pub mod diagnose;
+pub mod figures;
 pub mod lm;
 pub mod measure;
 pub mod pear_loop;

@@ -4,27 +4,25 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use plotters::prelude::*;
-use yarnhom_calib::bending_fit::BendingTest;
-use yarnhom_calib::diagnose::{BendingTrack, CauseId, DiagnoseSettings, Diagnosis, diagnose};
+use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
+use yarnhom_calib::figures;
 use yarnhom_calib::lm::LmSettings;
-use yarnhom_calib::measure::{Direction, Face, MeasurementSet, Phase};
+use yarnhom_calib::measure::{Direction, MeasurementSet, Phase};
 use yarnhom_calib::pear_loop::PearLoopTest;
 use yarnhom_calib::shell_fit::{MembraneModel, ShellBending, ShellFit, ShellFitSettings, fit_shell};
-use yarnhom_calib::swatch::SimulatedReading;
 use yarnhom_calib::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, synthesize};
 
 /// Areal density of synthetic sets with bending tests (kg/m²): a mid-weight knit.
 const SYNTH_AREAL_DENSITY_KG_M2: f64 = 0.25;
-use yarnhom_calib::targets::{Target, TargetPlan};
+use yarnhom_calib::targets::TargetPlan;
 use yarnhom_calib::yarn_confirm::{SearchSize, YarnLevel, confirm_diagnosis, skipped};
 use yarnhom_calib::yarn_fit::{YarnFitEvent, YarnFitSettings};
 
+use yarnhom_figures::render_svg;
 use yarnhom_shell::HingeBending;
 
 use crate::Outcome;
 use crate::calibrate_yarn::{set_basis, set_pattern};
-use crate::fit_plot::{FONT, format_value, plot_error, render};
 
 #[derive(Debug, Subcommand)]
 pub enum CalibrateCommand {
@@ -254,15 +252,12 @@ fn shell(args: ShellArgs) -> Result<Outcome> {
     std::fs::write(&json, serde_json::to_string_pretty(&fit)?)
         .with_context(|| format!("cannot write {}", json.display()))?;
     let svg = args.output.join("shell-fit.svg");
-    std::fs::write(&svg, plot_shell_fit(&set, &fit)?)
+    std::fs::write(&svg, render_svg(&figures::shell_fit_figure(&set, &fit))?)
         .with_context(|| format!("cannot write {}", svg.display()))?;
     let mut written = format!("{} and {}", json.display(), svg.display());
-    if let Some(ShellBending { fit: Some(bending), tests, measured, .. }) = &fit.bending {
+    if let Some(figure) = figures::shell_bending_figure(&fit) {
         let path = args.output.join("bending.svg");
-        let fitted = vec![true; tests.len()];
-        let predictions = [("fitted".to_string(), bending.simulated.clone())];
-        let figure = BendingFigure { tests, measured, fitted: &fitted, predictions: &predictions };
-        std::fs::write(&path, plot_bending(&fit.fabric, figure)?)
+        std::fs::write(&path, render_svg(&figure)?)
             .with_context(|| format!("cannot write {}", path.display()))?;
         written += &format!(" and {}", path.display());
     }
@@ -336,11 +331,11 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
     };
     write("report.json", serde_json::to_string_pretty(&d)?)?;
     write("report.md", report_markdown(&d))?;
-    write("fit.svg", plot_diagnosis(&set, &d)?)?;
-    write("residuals.svg", plot_residuals(&d)?)?;
+    write("fit.svg", render_svg(&figures::diagnosis_figure(&set, &d))?)?;
+    write("residuals.svg", render_svg(&figures::residuals_figure(&d))?)?;
     let mut written = "report.json, report.md, fit.svg, residuals.svg".to_string();
-    if let Some(track) = &d.bending {
-        write("bending.svg", plot_bending(&d.fabric, track.into())?)?;
+    if let Some(figure) = figures::diagnosis_bending_figure(&d) {
+        write("bending.svg", render_svg(&figure)?)?;
         written += ", bending.svg";
     }
     println!("cause: {} ({})", d.cause.id.as_str(), d.cause.explanation);
@@ -692,415 +687,4 @@ fn bending_summary(bending: Option<&ShellBending>) -> Vec<String> {
         percent(Some(fit.error))
     ));
     lines
-}
-
-pub(crate) const MEASURED: RGBColor = RGBColor(0xB0, 0xB8, 0xC8);
-pub(crate) const TARGET: RGBColor = RGBColor(0x1F, 0x5F, 0xD0);
-pub(crate) const FITTED: RGBColor = RGBColor(0xC0, 0x30, 0x30);
-pub(crate) const UNIFORM: RGBColor = RGBColor(0x1A, 0x9A, 0x3A);
-const UNLOAD: RGBColor = RGBColor(0xE0, 0x90, 0x20);
-
-/// How a series is drawn.
-#[derive(Clone, Copy)]
-pub(crate) enum Mark {
-    /// Small filled dots (raw readings).
-    Speck(RGBColor),
-    /// Filled circles.
-    Dot(RGBColor),
-    /// Hollow circles.
-    Ring(RGBColor),
-    /// Crosses.
-    Cross(RGBColor),
-    /// A polyline.
-    Line(RGBColor),
-}
-
-pub(crate) struct Series {
-    pub label: String,
-    pub mark: Mark,
-    pub points: Vec<(f64, f64)>,
-}
-
-/// One chart of a figure: y against x (stretch unless said otherwise).
-pub(crate) struct Panel {
-    pub title: String,
-    pub x_label: &'static str,
-    pub y_label: String,
-    pub series: Vec<Series>,
-}
-
-/// Draw `panels` in a grid of `columns` (row-major) as an SVG string.
-pub(crate) fn plot_panels(panels: &[Panel], columns: usize) -> Result<String> {
-    let rows = panels.len().div_ceil(columns.max(1));
-    let size = (420 * columns as u32, 380 * rows as u32);
-    render(size, |root| {
-        for (area, panel) in root.split_evenly((rows, columns)).iter().zip(panels) {
-            draw_panel(area, panel)?;
-        }
-        Ok(())
-    })
-}
-
-fn draw_panel(area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>, panel: &Panel) -> Result<()> {
-    let points = || panel.series.iter().flat_map(|s| s.points.iter());
-    let x_max = points().map(|p| p.0).fold(0.0_f64, f64::max).max(1e-6) * 1.05;
-    let (lo, hi) = points().map(|p| p.1).fold((0.0_f64, 0.0_f64), |(a, b), y| (a.min(y), b.max(y)));
-    let pad = 0.05 * (hi - lo).max(1e-9);
-    let mut chart = ChartBuilder::on(area)
-        .caption(&panel.title, (FONT, 16))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(0.0..x_max, (lo - pad)..(hi + pad))
-        .map_err(plot_error)?;
-    chart
-        .configure_mesh()
-        .x_desc(panel.x_label)
-        .y_desc(panel.y_label.as_str())
-        .label_style((FONT, 12))
-        .x_label_formatter(&|x| format_value(*x))
-        .y_label_formatter(&|y| format_value(*y))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(plot_error)?;
-    for s in &panel.series {
-        let points = s.points.iter().copied();
-        let drawn = match s.mark {
-            Mark::Speck(c) => chart.draw_series(points.map(|p| Circle::new(p, 1, c.filled()))),
-            Mark::Dot(c) => chart.draw_series(points.map(|p| Circle::new(p, 4, c.filled()))),
-            Mark::Ring(c) => chart.draw_series(points.map(|p| Circle::new(p, 4, c.stroke_width(2)))),
-            Mark::Cross(c) => chart.draw_series(points.map(|p| Cross::new(p, 5, c.stroke_width(2)))),
-            Mark::Line(c) => chart.draw_series(LineSeries::new(points, c.stroke_width(2))),
-        }
-        .map_err(plot_error)?;
-        let mark = s.mark;
-        drawn.label(s.label.as_str()).legend(
-            move |(x, y)| -> DynElement<'static, SVGBackend<'_>, (i32, i32)> {
-                match mark {
-                    Mark::Line(c) => {
-                        PathElement::new(vec![(x - 8, y), (x + 8, y)], c.stroke_width(2)).into_dyn()
-                    }
-                    Mark::Cross(c) => Cross::new((x, y), 5, c.stroke_width(2)).into_dyn(),
-                    Mark::Ring(c) => Circle::new((x, y), 4, c.stroke_width(2)).into_dyn(),
-                    Mark::Speck(c) | Mark::Dot(c) => Circle::new((x, y), 3, c.filled()).into_dyn(),
-                }
-            },
-        );
-    }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .label_font((FONT, 12))
-        .draw()
-        .map_err(plot_error)
-}
-
-/// The quantity of a figure row: force or compression.
-#[derive(Clone, Copy)]
-enum Quantity {
-    Force,
-    Compression,
-}
-
-impl Quantity {
-    fn label(self) -> &'static str {
-        match self {
-            Quantity::Force => "force (N)",
-            Quantity::Compression => "compression",
-        }
-    }
-
-    fn of(self, force_n: f64, compression: Option<f64>) -> Option<f64> {
-        match self {
-            Quantity::Force => Some(force_n),
-            Quantity::Compression => compression,
-        }
-    }
-
-    fn of_reading(self, r: &SimulatedReading) -> f64 {
-        match self {
-            Quantity::Force => r.force_n,
-            Quantity::Compression => r.compression,
-        }
-    }
-}
-
-/// Raw loading readings of `direction` up to `s_max`, thinned to about 1500 points.
-fn raw_readings(
-    set: &MeasurementSet,
-    direction: Direction,
-    phase: Phase,
-    s_max: f64,
-    q: Quantity,
-) -> Vec<(f64, f64)> {
-    let readings: Vec<_> = set
-        .stretch
-        .iter()
-        .filter(|p| p.direction == direction && p.phase == phase && p.stretch <= s_max)
-        .collect();
-    let thin = (readings.len() / 1500).max(1);
-    readings
-        .iter()
-        .step_by(thin)
-        .filter_map(|p| q.of(p.force_n, p.compression).map(|v| (p.stretch, v)))
-        .collect()
-}
-
-fn target_points<'a>(targets: impl Iterator<Item = &'a Target>, q: Quantity) -> Vec<(f64, f64)> {
-    targets.filter_map(|t| q.of(t.force_n, t.compression).map(|v| (t.stretch, v))).collect()
-}
-
-/// Fig. 6.6: per direction a column, force vs stretch on top and compression vs stretch below;
-/// raw loading readings (grey), targets (blue), the clamped-swatch fit (red), the uniform test
-/// of the fitted material (green, (6.3)).
-fn plot_shell_fit(set: &MeasurementSet, fit: &ShellFit) -> Result<String> {
-    let directions: Vec<Direction> = fit.errors.by_direction.iter().map(|e| e.0).collect();
-    let mut panels = Vec::new();
-    for q in [Quantity::Force, Quantity::Compression] {
-        for &direction in &directions {
-            let specimen = set.fabric.swatch.specimen(direction);
-            let mine: Vec<(usize, &Target)> =
-                fit.targets.iter().enumerate().filter(|(_, t)| t.direction == direction).collect();
-            let s_max = mine.iter().map(|(_, t)| t.stretch).fold(0.0, f64::max) * 1.05;
-            let uniform = std::iter::once((0.0, 0.0)).chain(
-                fit.uniform_targets.iter().filter(|u| u.direction == direction).map(|u| {
-                    let p = u.point;
-                    (p.stretch, q.of(p.stress_n_m * specimen.width_m, Some(p.compression)).unwrap_or(0.0))
-                }),
-            );
-            panels.push(Panel {
-                x_label: "stretch",
-                title: format!("{} {direction}: {}", fit.fabric, q.label()),
-                y_label: q.label().into(),
-                series: vec![
-                    Series {
-                        label: "readings (load)".into(),
-                        mark: Mark::Speck(MEASURED),
-                        points: raw_readings(set, direction, Phase::Load, s_max, q),
-                    },
-                    Series {
-                        label: "uniform test (6.3)".into(),
-                        mark: Mark::Line(UNIFORM),
-                        points: uniform.collect(),
-                    },
-                    Series {
-                        label: "targets".into(),
-                        mark: Mark::Dot(TARGET),
-                        points: target_points(mine.iter().map(|(_, t)| *t), q),
-                    },
-                    Series {
-                        label: "clamped swatch, fitted".into(),
-                        mark: Mark::Cross(FITTED),
-                        points: mine
-                            .iter()
-                            .map(|(i, t)| (t.stretch, q.of_reading(&fit.simulated[*i])))
-                            .collect(),
-                    },
-                ],
-            });
-        }
-    }
-    plot_panels(&panels, directions.len())
-}
-
-/// The predictions of `id` at `direction`'s targets (load or unload).
-fn predicted(d: &Diagnosis, id: &str, direction: Direction, unload: bool, q: Quantity) -> Vec<(f64, f64)> {
-    let Some(p) = d.predictions.iter().find(|p| p.id == id) else { return Vec::new() };
-    let (targets, readings) =
-        if unload { (&d.unload_targets, &p.unload) } else { (&d.load_targets, &p.load) };
-    targets
-        .iter()
-        .zip(readings)
-        .filter(|(t, _)| t.direction == direction)
-        .map(|(t, r)| (t.stretch, q.of_reading(r)))
-        .collect()
-}
-
-/// Measured against base and extended: per direction force and compression, fitted targets
-/// filled, held-out ones hollow, unloading in orange.
-fn plot_diagnosis(set: &MeasurementSet, d: &Diagnosis) -> Result<String> {
-    let directions: Vec<Direction> =
-        Direction::ALL.into_iter().filter(|x| d.load_targets.iter().any(|t| t.direction == *x)).collect();
-    let extended = d.extended.as_ref().map(|e| e.id.clone());
-    let mut panels = Vec::new();
-    for q in [Quantity::Force, Quantity::Compression] {
-        for &direction in &directions {
-            let s_max = d
-                .load_targets
-                .iter()
-                .filter(|t| t.direction == direction)
-                .map(|t| t.stretch)
-                .fold(0.0, f64::max)
-                * 1.05;
-            let split = |fitted: bool| {
-                target_points(
-                    d.load_targets
-                        .iter()
-                        .zip(&d.load_fitted)
-                        .filter(|(t, f)| t.direction == direction && **f == fitted)
-                        .map(|(t, _)| t),
-                    q,
-                )
-            };
-            let mut series = vec![
-                Series {
-                    label: "readings (load)".into(),
-                    mark: Mark::Speck(MEASURED),
-                    points: raw_readings(set, direction, Phase::Load, s_max, q),
-                },
-                Series { label: "fitted targets".into(), mark: Mark::Dot(TARGET), points: split(true) },
-                Series { label: "held-out targets".into(), mark: Mark::Ring(TARGET), points: split(false) },
-                Series {
-                    label: "base".into(),
-                    mark: Mark::Line(BLACK),
-                    points: predicted(d, "base", direction, false, q),
-                },
-            ];
-            if let Some(id) = &extended {
-                series.push(Series {
-                    label: id.clone(),
-                    mark: Mark::Line(FITTED),
-                    points: predicted(d, id, direction, false, q),
-                });
-            }
-            if d.unload_targets.iter().any(|t| t.direction == direction) {
-                series.push(Series {
-                    label: "unloading targets".into(),
-                    mark: Mark::Ring(UNLOAD),
-                    points: target_points(d.unload_targets.iter().filter(|t| t.direction == direction), q),
-                });
-                let id = extended.as_deref().unwrap_or("base");
-                series.push(Series {
-                    label: format!("{id}, unloading"),
-                    mark: Mark::Cross(UNLOAD),
-                    points: predicted(d, id, direction, true, q),
-                });
-            }
-            panels.push(Panel {
-                x_label: "stretch",
-                title: format!("{} {direction}: {}", d.fabric, q.label()),
-                y_label: q.label().into(),
-                series,
-            });
-        }
-    }
-    plot_panels(&panels, directions.len())
-}
-
-/// The readings of bending tests and the models' simulations of them.
-struct BendingFigure<'a> {
-    tests: &'a [BendingTest],
-    measured: &'a [f64],
-    fitted: &'a [bool],
-    predictions: &'a [(String, Vec<f64>)],
-}
-
-impl<'a> From<&'a BendingTrack> for BendingFigure<'a> {
-    fn from(t: &'a BendingTrack) -> Self {
-        Self { tests: &t.tests, measured: &t.measured, fitted: &t.fitted, predictions: &t.predictions }
-    }
-}
-
-/// Bending tests: per direction, pear-loop aspect ratio against clamp distance and cantilever
-/// tip drop against overhang (both faces), measured (fitted filled, held out hollow) against
-/// the models (first black, second red).
-fn plot_bending(fabric: &str, track: BendingFigure<'_>) -> Result<String> {
-    let directions: Vec<Direction> =
-        Direction::ALL.into_iter().filter(|d| track.tests.iter().any(|t| t.direction() == *d)).collect();
-    let kinds: [(&str, &'static str, &str); 3] = [
-        ("pear loop", "clamp distance (m)", "aspect ratio"),
-        ("cantilever, face up", "overhang (m)", "tip drop (m)"),
-        ("cantilever, face down", "overhang (m)", "tip drop (m)"),
-    ];
-    let kind_of = |t: &BendingTest| match t {
-        BendingTest::PearLoop { .. } => 0,
-        BendingTest::Cantilever { face: Face::Up, .. } => 1,
-        BendingTest::Cantilever { face: Face::Down, .. } => 2,
-    };
-    let x_of = |t: &BendingTest| match t {
-        BendingTest::PearLoop { clamp_distance_m, .. } => *clamp_distance_m,
-        BendingTest::Cantilever { overhang_m, .. } => *overhang_m,
-    };
-    let mut panels = Vec::new();
-    for (k, (kind, x_label, y_label)) in kinds.iter().enumerate() {
-        if !track.tests.iter().any(|t| kind_of(t) == k) {
-            continue;
-        }
-        for &direction in &directions {
-            let mine: Vec<usize> = (0..track.tests.len())
-                .filter(|&i| kind_of(&track.tests[i]) == k && track.tests[i].direction() == direction)
-                .collect();
-            let mut sorted = mine.clone();
-            sorted.sort_by(|a, b| x_of(&track.tests[*a]).total_cmp(&x_of(&track.tests[*b])));
-            let measured = |fitted: bool| {
-                mine.iter()
-                    .filter(|&&i| track.fitted[i] == fitted)
-                    .map(|&i| (x_of(&track.tests[i]), track.measured[i]))
-                    .collect()
-            };
-            let mut series = vec![
-                Series { label: "measured, fitted".into(), mark: Mark::Dot(TARGET), points: measured(true) },
-                Series {
-                    label: "measured, held out".into(),
-                    mark: Mark::Ring(TARGET),
-                    points: measured(false),
-                },
-            ];
-            for ((id, simulated), colour) in track.predictions.iter().zip([BLACK, FITTED]) {
-                series.push(Series {
-                    label: id.clone(),
-                    mark: Mark::Line(colour),
-                    points: sorted.iter().map(|&i| (x_of(&track.tests[i]), simulated[i])).collect(),
-                });
-            }
-            panels.push(Panel {
-                title: format!("{fabric} {direction}: {kind}"),
-                x_label,
-                y_label: (*y_label).into(),
-                series,
-            });
-        }
-    }
-    plot_panels(&panels, directions.len())
-}
-
-/// Residuals (model minus measured, over the measured value's scale) against stretch per
-/// direction and quantity, for the base and the extension, loading targets.
-fn plot_residuals(d: &Diagnosis) -> Result<String> {
-    let directions: Vec<Direction> =
-        Direction::ALL.into_iter().filter(|x| d.load_targets.iter().any(|t| t.direction == *x)).collect();
-    let mut panels = Vec::new();
-    for q in [Quantity::Force, Quantity::Compression] {
-        for &direction in &directions {
-            let mine: Vec<&Target> = d.load_targets.iter().filter(|t| t.direction == direction).collect();
-            let scale = mine.iter().filter_map(|t| q.of(t.force_n, t.compression)).map(f64::abs).sum::<f64>()
-                / mine.len().max(1) as f64;
-            let scale = scale.max(if matches!(q, Quantity::Compression) { 0.01 } else { 1e-12 });
-            let residual = |id: &str| -> Vec<(f64, f64)> {
-                predicted(d, id, direction, false, q)
-                    .into_iter()
-                    .zip(&mine)
-                    .filter_map(|((s, v), t)| q.of(t.force_n, t.compression).map(|m| (s, (v - m) / scale)))
-                    .collect()
-            };
-            let mut series =
-                vec![Series { label: "base".into(), mark: Mark::Dot(BLACK), points: residual("base") }];
-            if let Some(e) = &d.extended {
-                series.push(Series {
-                    label: e.id.clone(),
-                    mark: Mark::Cross(FITTED),
-                    points: residual(&e.id),
-                });
-            }
-            panels.push(Panel {
-                x_label: "stretch",
-                title: format!("{} {direction}: {} residual", d.fabric, q.label()),
-                y_label: "(model - measured) / mean".into(),
-                series,
-            });
-        }
-    }
-    plot_panels(&panels, directions.len())
 }

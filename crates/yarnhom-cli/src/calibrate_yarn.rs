@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use yarnhom_artifacts::{InputRef, Pattern, Provenance, container};
+use yarnhom_calib::figures::yarn_fit_figure;
 use yarnhom_calib::measure::MeasurementSet;
 use yarnhom_calib::shell_fit::{ShellFit, ShellFitSettings, fit_shell};
 use yarnhom_calib::swarm::SwarmSettings;
@@ -12,9 +13,9 @@ use yarnhom_calib::yarn_fit::{
     LocalSolver, RestShapeSettings, YarnFit, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn,
 };
 use yarnhom_calib::yarn_params::YarnBasis;
+use yarnhom_figures::render_svg;
 
 use crate::Outcome;
-use crate::calibrate::{FITTED, Mark, Panel, Series, TARGET, plot_panels};
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum LocalArg {
@@ -161,7 +162,7 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
         &fitted.rest_pattern,
         &Provenance::of("calibrate yarn", from),
     )?;
-    std::fs::write(args.output.join("yarn-fit.svg"), plot_yarn_fit(&fitted.fit)?)
+    std::fs::write(args.output.join("yarn-fit.svg"), render_svg(&yarn_fit_figure(&fitted.fit))?)
         .with_context(|| format!("cannot write {}", args.output.join("yarn-fit.svg").display()))?;
     println!("{}", summary(&fitted.fit));
     eprintln!(
@@ -275,45 +276,3 @@ fn summary(fit: &YarnFit) -> String {
     }
     lines.join("\n")
 }
-
-/// Fig. 6.13 style: per direction, the second Piola-Kirchhoff stretch stress and the
-/// compression of the shell's uniform targets and of the yarn tile, with the comfort limit.
-fn plot_yarn_fit(fit: &YarnFit) -> Result<String> {
-    let mut panels = Vec::new();
-    for quantity in ["stress σ_s/(1+s) [N/m]", "compression c"] {
-        for (t, c) in fit.targets.iter().zip(&fit.simulated) {
-            let value = |s: f64, sigma: f64, comp: f64| {
-                if quantity.starts_with("stress") { sigma / (1.0 + s) } else { comp }
-            };
-            let target: Vec<(f64, f64)> = (0..t.stretch.len())
-                .map(|i| (t.stretch[i], value(t.stretch[i], t.stress_n_m[i], t.compression[i])))
-                .collect();
-            let yarn: Vec<(f64, f64)> = (0..c.stretch.len())
-                .map(|i| (c.stretch[i], value(c.stretch[i], c.stress_n_m[i], c.compression[i])))
-                .collect();
-            let top = target.iter().chain(&yarn).map(|p| p.1).fold(0.0, f64::max);
-            panels.push(Panel {
-                x_label: "stretch",
-                title: format!(
-                    "{} {}: {}",
-                    fit.fabric,
-                    t.direction,
-                    quantity.split(' ').next().unwrap_or(quantity)
-                ),
-                y_label: quantity.into(),
-                series: vec![
-                    Series { label: "shell targets (6.3)".into(), mark: Mark::Line(TARGET), points: target },
-                    Series { label: "yarn tile, estimated".into(), mark: Mark::Cross(FITTED), points: yarn },
-                    Series {
-                        label: "end of comfort range (2 N)".into(),
-                        mark: Mark::Line(COMFORT),
-                        points: vec![(t.comfort_stretch, 0.0), (t.comfort_stretch, top)],
-                    },
-                ],
-            });
-        }
-    }
-    plot_panels(&panels, fit.targets.len())
-}
-
-const COMFORT: plotters::style::RGBColor = plotters::style::RGBColor(0x40, 0x40, 0x40);

@@ -258,7 +258,9 @@ fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
     let spline = open_artifact::<Spline>(&args.spline)?.value;
     std::fs::create_dir_all(&args.output)
         .with_context(|| format!("cannot create {}", args.output.display()))?;
-    for path in crate::fit_plot::plot_fit(&grid, &spline, &args.output)? {
+    for (file, figure) in yarnhom_fit::figures::fit_figures(&grid, &spline) {
+        let path = args.output.join(file);
+        write_bytes(&path, yarnhom_figures::render_svg(&figure)?.as_bytes())?;
         wrote(&path);
     }
     Ok(Outcome::Success)

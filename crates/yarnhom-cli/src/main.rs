@@ -10,7 +10,6 @@ mod calibrate_yarn;
 mod convert;
 mod diff;
 mod fit;
-mod fit_plot;
 mod grid;
 mod inspect;
 mod measure;

@@ -3,6 +3,7 @@
 pub mod compare;
 pub mod curvature;
 pub mod difference;
+pub mod figures;
 pub mod fit;
 pub mod hermite;
 pub mod march;
