@@ -4,11 +4,11 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use yarnhom_calib::report::CalibrationReport;
 use clap::Args;
 use yarnhom_artifacts::AnyArtifact;
 use yarnhom_artifacts::diff::{Diff, Tolerance, diff, diff_documents};
 use yarnhom_artifacts::open::{Contents, open};
-use yarnhom_calib::report::CalibrationReport;
 use yarnhom_fit::diff_spline_materials;
 use yarnhom_trace::{diff_traces, open_source};
 

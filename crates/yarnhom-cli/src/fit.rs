@@ -11,10 +11,8 @@ use yarnhom_artifacts::open::{Format, Opened, open, open_artifact};
 use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, Spline};
 use yarnhom_fit::fit::restrict_grid;
 use yarnhom_fit::ranges::STOCKINETTE_SPAN_2D_BENDING;
-use yarnhom_fit::{
-    SplineMaterial, TermShape, compare_1d_terms, fit_errors, fit_grid_with_regularized_terms,
-    regularized_term_shapes, term_shapes,
-};
+use yarnhom_fit::report::fit_report;
+use yarnhom_fit::{compare_1d_terms, fit_grid_with_regularized_terms};
 
 use crate::Outcome;
 use crate::args::{parse_axis, parse_interval};
@@ -182,54 +180,9 @@ fn fit(args: GridFitArgs) -> anyhow::Result<Outcome> {
             grid.samples.len()
         );
     }
-    print_errors(&fitted, &spline, !args.no_shear_symmetry);
-    print_shapes(&fitted, &spline, &fit.regularized_2d);
+    println!("{}", fit_report(&fitted, &spline, &fit.regularized_2d, !args.no_shear_symmetry));
     wrote(output);
     Ok(Outcome::Success)
-}
-
-/// The fit's relative RMS error on each term of its grid (the acceptance figure).
-fn print_errors(grid: &Grid, spline: &Spline, symmetrized_shear: bool) {
-    let material = SplineMaterial::from(spline);
-    println!(
-        "relative RMS error of the fit on its grid: of Ψ; of Ψ - f0; of Ψ as modelled (2D terms without compression, A.3.6{}):",
-        if symmetrized_shear { "; symmetrized in sa, Sec. 4.1" } else { "" }
-    );
-    for e in fit_errors(grid, &material, spline.rest_energy_density_j_m2, symmetrized_shear) {
-        let modelled = e
-            .relative_rms_modelled
-            .map_or("-".to_string(), |r| format!("{:6.2}% ({} samples)", 100.0 * r, e.samples_modelled));
-        println!(
-            "  {:8} {:5} samples  {:6.2}%  {:6.2}%  {modelled}",
-            e.term,
-            e.samples,
-            100.0 * e.relative_rms,
-            100.0 * e.relative_rms_deformation
-        );
-    }
-}
-
-/// Whether each quasiconvexified term, and the material's energy on each term's plane, has a
-/// single minimum along its lines (A.36).
-fn print_shapes(grid: &Grid, spline: &Spline, regularized_2d: &[yarnhom_artifacts::BicubicTerm]) {
-    println!(
-        "single minimum along every line through each term's control points, halfway between them and \
-         along the edges, over 1.5x the sampled range (A.36); of each quasiconvexified term (the 1D \
-         terms, the 2D terms' regularized fits f*, Sec. 4.1.2) / of the material's energy on the term's \
-         axis or plane (f0 + f_u + f_v + f_uv, their sum, which the thesis allows more minima):"
-    );
-    let terms = regularized_term_shapes(grid, spline, regularized_2d, 1e-6);
-    for (term, material) in terms.iter().zip(term_shapes(grid, spline, 1e-6)) {
-        println!("  {:8} {} / {}", term.term, shape_verdict(term), shape_verdict(&material));
-    }
-}
-
-/// `yes (N lines)` or `NO on K of N lines, e.g. ...`.
-fn shape_verdict(shape: &TermShape) -> String {
-    match shape.violations.first() {
-        None => format!("yes ({} lines)", shape.lines),
-        Some(first) => format!("NO on {} of {} lines, e.g. {first}", shape.violations.len(), shape.lines),
-    }
 }
 
 fn import(args: ImportArgs) -> anyhow::Result<Outcome> {

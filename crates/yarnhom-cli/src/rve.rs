@@ -216,17 +216,7 @@ fn residual(args: ResidualArgs) -> anyhow::Result<Outcome> {
         "forces at the stored state of '{}' under '{}' (projected on the constraints):",
         pattern.name, model.name
     );
-    println!("  stretching          {:.4e} N", r.stretch);
-    println!("  bending, twisting   {:.4e} N", r.bend_twist);
-    println!("  contact             {:.4e} N", r.contact);
-    println!("  total               {:.4e} N ({:.3} of the stretching force)", r.total, r.relative_at(1.0));
-    match r.best_contact_scale() {
-        Some(c) => println!(
-            "  best contact scale  {c:.3} (the contact that balances this state best), leaving {:.3} of the stretching force",
-            r.relative_at(c)
-        ),
-        None => println!("  no contact force: no yarns within reach of each other"),
-    }
+    println!("{}", r.report());
     Ok(Outcome::Success)
 }
 

@@ -12,6 +12,7 @@ pub mod mls;
 pub mod monotone_bicubic;
 pub mod monotone_cubic;
 pub mod ranges;
+pub mod report;
 pub mod residual;
 pub mod shape;
 pub mod synthetic;

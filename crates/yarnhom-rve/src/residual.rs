@@ -48,6 +48,30 @@ impl EquilibriumResidual {
         let [_, ab, bb] = self.quadratic;
         (bb > 0.0).then(|| -ab / bb)
     }
+
+    /// The residual as `yarnhom rve residual` prints it: the generalized forces of each kind,
+    /// their total relative to the stretching force, and the contact scale that balances the
+    /// state best.
+    pub fn report(&self) -> String {
+        let mut lines = vec![
+            format!("  stretching          {:.4e} N", self.stretch),
+            format!("  bending, twisting   {:.4e} N", self.bend_twist),
+            format!("  contact             {:.4e} N", self.contact),
+            format!(
+                "  total               {:.4e} N ({:.3} of the stretching force)",
+                self.total,
+                self.relative_at(1.0)
+            ),
+        ];
+        lines.push(match self.best_contact_scale() {
+            Some(c) => format!(
+                "  best contact scale  {c:.3} (the contact that balances this state best), leaving {:.3} of the stretching force",
+                self.relative_at(c)
+            ),
+            None => "  no contact force: no yarns within reach of each other".into(),
+        });
+        lines.join("\n")
+    }
 }
 
 /// The contact scale that best balances several stored states together: least squares over
