@@ -7,6 +7,7 @@
 //! - [`AnyArtifact`]: a file of any kind, for tools that dispatch on the kind (`inspect`, `convert`).
 //! - Interop: [`pyp`] (published HYLC patterns), [`mod@hdf5`] (feature `hdf5`), JSON ([`JsonDocument`]).
 //! - [`schema`]: JSON Schemas generated from the types.
+//! - [`report`]: versioned JSON reports (the calibration's `shell-fit.json`, `report.json`, ...).
 
 pub mod arcsim;
 pub mod check;
@@ -18,6 +19,7 @@ pub mod grid;
 pub mod hdf5;
 pub mod pattern;
 pub mod pyp;
+pub mod report;
 pub mod rvesolve;
 pub mod schema;
 pub mod spline;
