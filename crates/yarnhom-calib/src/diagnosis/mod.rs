@@ -23,15 +23,15 @@
 //!    `k_θ`), `anisotropic-bending` (`k_θ` per direction) and `rest-curvature` (one `k_θ` and a
 //!    rest curvature per direction, seen only by the cantilever tests on both faces); without
 //!    the tests (or the areal density) they are not testable, with the reason.
-//! 4. Choice: the [`DecisionRule`](rule::DecisionRule) (held-out error against the track's
+//! 4. Choice: the [`DecisionRule`] (held-out error against the track's
 //!    base and noise, the Akaike criterion, the share of the discrepancy fixed; `none` and
 //!    `unexplained` when no candidate passes) names the cause.
 //! 5. Evidence: the numbers behind the choice, worded from the same rule.
 //! 6. Confirmation (separate, [`confirm`], run by `calibrate diagnose` unless `--budget
 //!    quick`): a cause with a mechanism in the yarn model is confirmed on the periodic tile by
 //!    nested yarn-level fits to the extended shell's uniform targets
-//!    ([`Diagnosis::extended_material`](report::Diagnosis::extended_material)); the result
-//!    goes to [`Diagnosis::yarn_level`](report::Diagnosis::yarn_level).
+//!    ([`Diagnosis::extended_material`]); the result
+//!    goes to [`Diagnosis::yarn_level`].
 //!
 //! Errors are RMS values of the normalized residuals of (6.2) (force over the direction's mean
 //! force, compression over its mean compression), pooled over the fitted or the held-out
@@ -42,7 +42,7 @@
 //! to each test group, pooled over the residual degrees of freedom (an upper bound where a
 //! curve is not cubic).
 //!
-//! The report ([`report::Diagnosis`], `report.json`) and its Markdown rendering
+//! The report ([`Diagnosis`], `report.json`) and its Markdown rendering
 //! ([`markdown`], `report.md`) hold every number; [`settings`] says how to diagnose.
 
 pub mod bending;
@@ -88,7 +88,8 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
     let (gain, extended) = (choice.gain(&tracks), choice.extended.cloned());
     let id = cause.id;
     let mut bending_track = bending.track;
-    if let (Some(t), Some((cid, f))) = (bending_track.as_mut(), screened.bending_fits.iter().find(|(c, _)| *c == id))
+    if let (Some(t), Some((cid, f))) =
+        (bending_track.as_mut(), screened.bending_fits.iter().find(|(c, _)| *c == id))
     {
         t.predictions.push((cid.as_str().into(), f.simulated.clone()));
     }
@@ -153,7 +154,9 @@ fn fit_candidates(
             (CauseId::FrictionHysteresis, None) => {
                 ModelResult::untestable(id, phases.unload_note().unwrap_or("no unloading data"))
             }
-            (_, None) => ModelResult::untestable(id, "the extended swatch has no equilibrium from the base fit"),
+            (_, None) => {
+                ModelResult::untestable(id, "the extended swatch has no equilibrium from the base fit")
+            }
         };
         screened.results.push(result);
     }

@@ -26,6 +26,21 @@ pub const GRAVITY: f64 = 9.81;
 /// strip's), and a narrow strip is seven times cheaper.
 pub const STRIP_WIDTH_M: f64 = 0.01;
 
+/// The hinge bending of per-direction stiffnesses `k_j` (J) and rest curvatures
+/// `rest_curvature_per_m` (1/m), each given as one value for every direction or as three
+/// (weft, bias, warp); `None` for any other count.
+pub fn hinge_bending(k_j: &[f64], rest_curvature_per_m: &[f64]) -> Option<HingeBending> {
+    let [k_weft, k_bias, k_warp] = Direction::per_direction(k_j)?;
+    let [rest_curvature_weft, rest_curvature_bias, rest_curvature_warp] =
+        Direction::per_direction(rest_curvature_per_m)?;
+    Some(HingeBending {
+        rest_curvature_weft,
+        rest_curvature_bias,
+        rest_curvature_warp,
+        ..HingeBending::anisotropic(k_weft, k_bias, k_warp)
+    })
+}
+
 /// Which ends are clamped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Clamps {
@@ -147,5 +162,20 @@ impl Strip {
             .zip(&self.arc)
             .filter(|(_, (s, _))| (*s - self.length_m).abs() < 1e-9 * self.length_m)
             .map(|(p, _)| p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hinge_bending_takes_one_value_for_every_direction_or_three() {
+        assert_eq!(hinge_bending(&[2e-6], &[0.0]), Some(HingeBending::isotropic(2e-6)));
+        let b = hinge_bending(&[3e-6, 2e-6, 1e-6], &[10.0]).expect("three and one");
+        assert_eq!((b.k_weft, b.k_bias, b.k_warp), (3e-6, 2e-6, 1e-6));
+        assert_eq!((b.rest_curvature_weft, b.rest_curvature_bias, b.rest_curvature_warp), (10.0, 10.0, 10.0));
+        assert_eq!(hinge_bending(&[1e-6, 2e-6], &[0.0]), None);
+        assert_eq!(hinge_bending(&[1e-6], &[]), None);
     }
 }

@@ -46,6 +46,18 @@ impl Default for SwarmSettings {
     }
 }
 
+impl SwarmSettings {
+    /// Shard `k` of `n` independent sub-swarms of these settings: `n` times fewer particles (at
+    /// least one) and the seed offset by `7919 k`, so the shards search apart.
+    pub fn shard(self, k: u32, n: u32) -> Self {
+        SwarmSettings {
+            particles: (self.particles / n as usize).max(1),
+            seed: self.seed.wrapping_add(u64::from(k) * 7919),
+            ..self
+        }
+    }
+}
+
 /// The result of a swarm run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SwarmReport {
@@ -155,7 +167,8 @@ impl Swarm {
         let mut position: Vec<Vec<f64>> =
             (0..particles).map(|_| (0..dim).map(|_| random.next()).collect()).collect();
         for (p, seed) in position.iter_mut().zip(seeds) {
-            *p = seed.iter().zip(bounds).map(|(x, (lo, hi))| ((x - lo) / (hi - lo)).clamp(0.0, 1.0)).collect();
+            *p =
+                seed.iter().zip(bounds).map(|(x, (lo, hi))| ((x - lo) / (hi - lo)).clamp(0.0, 1.0)).collect();
         }
         let velocity: Vec<Vec<f64>> =
             (0..particles).map(|_| (0..dim).map(|_| 0.2 * (random.next() - 0.5)).collect()).collect();
@@ -262,5 +275,14 @@ mod tests {
         let report = minimize(cost, &[(-1.0, 1.0)], &SwarmSettings::default(), &[], &|_, _| {});
         assert!(report.failures > 0);
         assert!((report.best[0] - 0.5).abs() < 0.05, "{report:?}");
+    }
+
+    #[test]
+    fn shards_split_the_particles_and_offset_the_seed() {
+        let settings = SwarmSettings { particles: 64, seed: 5, ..SwarmSettings::default() };
+        let shard = settings.shard(3, 4);
+        assert_eq!((shard.particles, shard.seed), (16, 5 + 3 * 7919));
+        assert_eq!(SwarmSettings { particles: 3, ..settings }.shard(0, 4).particles, 1);
+        assert_eq!(SwarmSettings { seed: u64::MAX, ..settings }.shard(1, 2).seed, 7918);
     }
 }

@@ -21,6 +21,7 @@ use std::time::Instant;
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use yarnhom_artifacts::report::Report;
 use yarnhom_shell::{Stiffening, StvkNeoHookean};
 
 use super::bending::{BendingFit, BendingModel, fit_bending};
@@ -178,6 +179,116 @@ pub const SHELL_FIT_VERSION: u32 = 1;
 /// The JSON Schema of `shell-fit.json`.
 pub fn shell_fit_schema() -> schemars::Schema {
     schemars::schema_for!(ShellFit)
+}
+
+impl Report for ShellFit {
+    const FORMAT: &'static str = SHELL_FIT_FORMAT;
+    const VERSION: u32 = SHELL_FIT_VERSION;
+
+    /// The material, the errors per direction (fitted and screening), the optimizer and the
+    /// mesh check, then the bending fit.
+    fn summary(&self) -> String {
+        let m = &self.material;
+        let mut lines = vec![
+            format!("fabric {}: {}", self.fabric, self.settings.model.name()),
+            format!(
+                "  k_xx {:.4} k_xy {:.4} k_yy {:.4} k_ss {:.4} k_n1 {:.4} k_n2 {:.4} (J/m²)",
+                m.k_xx, m.k_xy, m.k_yy, m.k_ss, m.k_n1, m.k_n2
+            ),
+        ];
+        if let Some(j) = m.jamming {
+            lines.push(format!(
+                "  jamming past compressive Green strain {:.4}: k_weft {:.4} k_warp {:.4} (J/m²)",
+                j.onset, j.k_weft, j.k_warp
+            ));
+        }
+        if !self.unconstrained.is_empty() {
+            lines.push(format!("  not constrained by the data (held): {}", self.unconstrained.join(", ")));
+        }
+        lines.extend(self.error_lines());
+        let refinement = self.mesh_refinement_change.map_or("no equilibrium on the finer mesh".into(), |c| {
+            format!("a mesh twice as fine changes a reading by {:.1}%", 100.0 * c)
+        });
+        lines.push(format!(
+            "  {} Levenberg-Marquardt iterations, {} swatch simulations, {:.1} s; {} vertices per swatch; {refinement}",
+            self.optimizer.iterations, self.optimizer.evaluations, self.wall_time_s, self.vertices,
+        ));
+        lines.extend(ShellBending::summary_lines(self.bending.as_ref()));
+        lines.join("\n")
+    }
+}
+
+impl ShellFit {
+    /// The errors table of the summary: per direction and their means, the screening
+    /// material's in brackets.
+    fn error_lines(&self) -> Vec<String> {
+        let mut lines = vec![
+            "  direction  force error  compression error  (the screening material, fitted to the uniform test)"
+                .to_string(),
+        ];
+        for ((d, f, c), (_, sf, sc)) in
+            self.errors.by_direction.iter().zip(&self.screening_errors.by_direction)
+        {
+            lines.push(format!(
+                "  {:<9}  {:>11}  {:>17}  ({} / {})",
+                d.as_str(),
+                percent(Some(*f)),
+                percent(*c),
+                percent(Some(*sf)),
+                percent(*sc)
+            ));
+        }
+        lines.push(format!(
+            "  mean       {:>11}  {:>17}  (thesis Sec. 6.3.1 average over 33 fabrics: 17.6% / 16.8%)",
+            percent(Some(self.errors.force)),
+            percent(self.errors.compression)
+        ));
+        lines
+    }
+}
+
+impl ShellBending {
+    /// The bending lines of a shell fit's summary: stiffnesses and errors per direction, or
+    /// why there are none.
+    fn summary_lines(bending: Option<&ShellBending>) -> Vec<String> {
+        let Some(bending) = bending else { return vec!["bending: no bending tests in the set".into()] };
+        let Some(fit) = &bending.fit else {
+            return vec![format!(
+                "bending: not fitted: {}",
+                bending.note.as_deref().unwrap_or("unknown reason")
+            )];
+        };
+        let b = &fit.bending;
+        let mut lines = vec![
+            format!(
+                "bending (6.4): k_weft {:.3e} k_bias {:.3e} k_warp {:.3e} J ({} simulations of the {} tests)",
+                b.k_weft,
+                b.k_bias,
+                b.k_warp,
+                fit.evaluations,
+                bending.tests.len()
+            ),
+            "  direction  pear-loop error  cantilever error".into(),
+        ];
+        for e in &fit.by_direction {
+            lines.push(format!(
+                "  {:<9}  {:>15}  {:>16}",
+                e.direction.as_str(),
+                percent(e.pear_loop),
+                percent(e.cantilever)
+            ));
+        }
+        lines.push(format!(
+            "  all        {:>15}  (thesis Sec. 6.3.2 pear-loop average: 5.61%)",
+            percent(Some(fit.error))
+        ));
+        lines
+    }
+}
+
+/// A fraction as a percentage with one decimal, `-` when absent.
+fn percent(x: Option<f64>) -> String {
+    x.map_or("-".into(), |x| format!("{:.1}%", 100.0 * x))
 }
 
 /// Fit the membrane of `settings.model` to `set`'s stretch tests.
