@@ -1,6 +1,4 @@
-//! Calibration of yarnhom's models against real fabric measurements (thesis Ch. 6), in rooms,
-//! each using only the ones before it: [`optimize`], [`data`], [`experiments`], [`shell`],
-//! [`cause`], [`yarn`], [`diagnosis`]; [`report`] reads any of their reports.
+#![doc = include_str!("../README.md")]
 
 pub mod cause;
 pub mod data;
