@@ -20,16 +20,17 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use yarnhom_artifacts::pyp::parse_pyp;
-use yarnhom_calib::bending_fit::BENDING_SPACING_M;
-use yarnhom_calib::cantilever::CantileverTest;
-use yarnhom_calib::measure::{Direction, Face, MeasurementSet};
-use yarnhom_calib::pear_loop::PearLoopTest;
-use yarnhom_calib::stitch_by_stitch::import_fabric;
-use yarnhom_calib::swatch::SwatchTest;
-use yarnhom_calib::synth::{BendingPlan, HiddenEffect, ground_truth};
-use yarnhom_calib::targets::{Target, TargetPlan, targets};
-use yarnhom_calib::yarn_fit::{TargetSource, YarnFitSettings, YarnProblem};
-use yarnhom_calib::yarn_params::YarnBasis;
+use yarnhom_calib::data::set::{Direction, Face, MeasurementSet};
+use yarnhom_calib::data::stitch_by_stitch::import_fabric;
+use yarnhom_calib::data::targets::{Target, TargetPlan, targets};
+use yarnhom_calib::experiments::bending_tests::BENDING_SPACING_M;
+use yarnhom_calib::experiments::cantilever::CantileverTest;
+use yarnhom_calib::experiments::pear_loop::PearLoopTest;
+use yarnhom_calib::experiments::swatch::SwatchTest;
+use yarnhom_calib::experiments::synth::{BendingPlan, HiddenEffect, ground_truth};
+use yarnhom_calib::yarn::params::YarnBasis;
+use yarnhom_calib::yarn::problem::{TargetSource, YarnProblem};
+use yarnhom_calib::yarn::settings::YarnFitSettings;
 use yarnhom_shell::StvkNeoHookean;
 
 /// The real acrylic stockinette set and its shell targets.

@@ -13,6 +13,7 @@ pub mod membrane;
 pub mod open;
 pub mod pattern;
 pub mod pyp;
+pub mod report;
 pub mod rvesolve;
 pub mod schema;
 pub mod spline;

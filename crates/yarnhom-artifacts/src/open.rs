@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use crate::container::{self, content_hash};
 use crate::error::{Error, Result};
 use crate::membrane::MembraneMaterial;
+use crate::report::report_format;
 use crate::{AnyArtifact, Artifact, Fabric, Header, InputRef, JsonDocument, Provenance, Spline, YarnModel};
 
 /// The first bytes of an HDF5 file.
@@ -244,13 +245,6 @@ fn decode_json(path: &Path, bytes: &[u8]) -> Result<(Format, Contents)> {
                 .into(),
         ))
     }
-}
-
-/// The `format` (`yarnhom.<name>`) and `version` of a versioned yarnhom JSON report.
-pub fn report_format(document: &serde_json::Value) -> Option<(&str, u32)> {
-    let format = document.get("format")?.as_str().filter(|f| f.starts_with("yarnhom."))?;
-    let version = u32::try_from(document.get("version")?.as_u64()?).ok()?;
-    Some((format, version))
 }
 
 fn json_error(message: String) -> Error {

@@ -4,13 +4,13 @@
 
 use yarnhom_figures::{Chart, ChartStyle, Colour, Figure, Mark, Panel, Series};
 
-use crate::bending_fit::BendingTest;
-use crate::diagnose::{BendingTrack, Diagnosis};
-use crate::measure::{Direction, Face, MeasurementSet, Phase};
-use crate::shell_fit::{ShellBending, ShellFit};
-use crate::swatch::SimulatedReading;
-use crate::targets::Target;
-use crate::yarn_fit::YarnFit;
+use crate::data::set::{Direction, Face, MeasurementSet, Phase};
+use crate::data::targets::Target;
+use crate::diagnosis::report::{BendingTrack, Diagnosis};
+use crate::experiments::bending_tests::BendingTest;
+use crate::experiments::swatch::SimulatedReading;
+use crate::shell::fit::{ShellBending, ShellFit};
+use crate::yarn::fit::YarnFit;
 
 /// Size of one chart (px).
 const PANEL_SIZE: (u32, u32) = (420, 380);

@@ -1,8 +1,11 @@
 //! Hidden-effect tests: a synthetic set is made from a ground truth with one effect hidden in
 //! it (or none), and the diagnosis, told nothing about it, must name it.
 
-use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, Diagnosis, diagnose};
-use yarnhom_calib::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, synthesize};
+use yarnhom_calib::cause::CauseId;
+use yarnhom_calib::diagnosis::diagnose;
+use yarnhom_calib::diagnosis::report::Diagnosis;
+use yarnhom_calib::diagnosis::settings::DiagnoseSettings;
+use yarnhom_calib::experiments::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, synthesize};
 
 /// Relative noise: force and compression noise as this fraction of their mean clean values.
 const NOISE: f64 = 0.02;

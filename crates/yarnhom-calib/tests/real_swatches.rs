@@ -4,9 +4,12 @@
 
 #![cfg(feature = "hdf5")]
 
-use yarnhom_calib::diagnose::{CauseId, DiagnoseSettings, diagnose};
-use yarnhom_calib::shell_fit::{MembraneModel, ShellFitSettings, fit_shell};
-use yarnhom_calib::stitch_by_stitch::import_fabric;
+use yarnhom_calib::cause::CauseId;
+use yarnhom_calib::data::stitch_by_stitch::import_fabric;
+use yarnhom_calib::diagnosis::diagnose;
+use yarnhom_calib::diagnosis::settings::DiagnoseSettings;
+use yarnhom_calib::shell::fit::{ShellFitSettings, fit_shell};
+use yarnhom_calib::shell::membrane::MembraneModel;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic");
 

@@ -1,9 +1,9 @@
 //! The committed calibration report schemas (`schemas/shell-fit.vN.schema.json`,
 //! `schemas/diagnosis.vN.schema.json`, `schemas/yarn-fit.vN.schema.json`) are current.
 
-use yarnhom_calib::diagnose::{DIAGNOSIS_VERSION, diagnosis_schema};
-use yarnhom_calib::shell_fit::{SHELL_FIT_VERSION, shell_fit_schema};
-use yarnhom_calib::yarn_fit::{YARN_FIT_VERSION, yarn_fit_schema};
+use yarnhom_calib::diagnosis::report::{DIAGNOSIS_VERSION, diagnosis_schema};
+use yarnhom_calib::shell::fit::{SHELL_FIT_VERSION, shell_fit_schema};
+use yarnhom_calib::yarn::fit::{YARN_FIT_VERSION, yarn_fit_schema};
 
 #[test]
 fn committed_report_schemas_are_current() {

@@ -4,8 +4,8 @@
 
 use std::path::PathBuf;
 
-use yarnhom_calib::stitch_by_stitch::{SATURATION_FORCE_N, import};
-use yarnhom_calib::{Direction, MeasurementSet, Phase, StretchPoint};
+use yarnhom_calib::data::set::{Direction, MeasurementSet, Phase, StretchPoint};
+use yarnhom_calib::data::stitch_by_stitch::{SATURATION_FORCE_N, import};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic/");
 

@@ -1,16 +1,17 @@
-//! The yarn-level confirmation of a diagnosed cause ([`yarnhom_calib::yarn_confirm`]) on targets
+//! The yarn-level confirmation of a diagnosed cause ([`yarnhom_calib::yarn::confirm`]) on targets
 //! simulated from hidden yarn models on the generated stockinette: a yarn that is soft and then
 //! stiff (biphasic stretch, (6.5)) must confirm `biphasic-stretch` (with a thorough search: a
 //! reduced one, swarm 16 x 3 and Gauss-Newton 8, stays in the base's basin, where the stiff
 //! linear yarn is compensated by softer contacts), and a linear yarn must not.
 
-use yarnhom_calib::Direction;
-use yarnhom_calib::diagnose::CauseId;
-use yarnhom_calib::swarm::SwarmSettings;
-use yarnhom_calib::yarn_confirm::{CONFIRM_RATIO, SearchSize, YarnConfirmation, confirm};
-use yarnhom_calib::yarn_fit::{RestShapeSettings, TargetSource, YarnFitSettings, YarnProblem};
-use yarnhom_calib::yarn_objective::COMFORT_FORCE_N;
-use yarnhom_calib::yarn_params::{YarnBasis, YarnMechanisms, YarnParams};
+use yarnhom_calib::cause::CauseId;
+use yarnhom_calib::data::set::Direction;
+use yarnhom_calib::optimize::swarm::SwarmSettings;
+use yarnhom_calib::yarn::confirm::{CONFIRM_RATIO, SearchSize, YarnConfirmation, confirm};
+use yarnhom_calib::yarn::objective::COMFORT_FORCE_N;
+use yarnhom_calib::yarn::params::{YarnBasis, YarnMechanisms, YarnParams};
+use yarnhom_calib::yarn::problem::{RestShapeSettings, TargetSource, YarnProblem};
+use yarnhom_calib::yarn::settings::YarnFitSettings;
 
 /// The problem of recovering `truth` on the generated stockinette, weft and warp to 50%.
 fn problem(truth: impl Fn(&YarnBasis) -> YarnParams) -> YarnProblem {

@@ -3,14 +3,14 @@
 //! model by the local optimizers.
 
 use yarnhom_artifacts::Pattern;
-use yarnhom_calib::Direction;
-use yarnhom_calib::swarm::SwarmSettings;
-use yarnhom_calib::yarn_fit::{
-    LocalSolver, RestShapeSettings, TargetSource, YarnFitSettings, YarnProblem, fit_yarn,
-};
-use yarnhom_calib::yarn_objective::{COMFORT_FORCE_N, residuals};
-use yarnhom_calib::yarn_params::YarnBasis;
-use yarnhom_calib::yarn_tile::{solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
+use yarnhom_calib::data::set::Direction;
+use yarnhom_calib::optimize::swarm::SwarmSettings;
+use yarnhom_calib::yarn::fit::fit_yarn;
+use yarnhom_calib::yarn::objective::{COMFORT_FORCE_N, residuals};
+use yarnhom_calib::yarn::params::YarnBasis;
+use yarnhom_calib::yarn::problem::{RestShapeSettings, TargetSource, YarnProblem};
+use yarnhom_calib::yarn::settings::{LocalSolver, YarnFitSettings};
+use yarnhom_calib::yarn::tile::{solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::{solve_at, stress_sensitivities};
 use yarnhom_rve::{RelaxMethod, RelaxOptions, RveModel, SolveOptions, relax};

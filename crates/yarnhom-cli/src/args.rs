@@ -16,3 +16,25 @@ pub fn parse_interval(text: &str) -> Result<[f64; 2], String> {
     let number = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("'{v}': {e}"));
     Ok([number(min)?, number(max)?])
 }
+
+/// A number of the range `ok` accepts, else `message`.
+pub fn number(text: &str, ok: impl Fn(f64) -> bool, message: &str) -> Result<f64, String> {
+    text.parse::<f64>().ok().filter(|x| ok(*x)).ok_or_else(|| message.to_string())
+}
+
+/// A finite number > 0 (a `value_parser`).
+pub fn positive(text: &str) -> Result<f64, String> {
+    number(text, |x| x.is_finite() && x > 0.0, "must be a positive finite number")
+}
+
+pub fn non_negative(text: &str) -> Result<f64, String> {
+    number(text, |x| x.is_finite() && x >= 0.0, "must be a number >= 0")
+}
+
+pub fn finite(text: &str) -> Result<f64, String> {
+    number(text, f64::is_finite, "must be a finite number")
+}
+
+pub fn max_stretch(text: &str) -> Result<f64, String> {
+    number(text, |x| x.is_finite() && x > 0.0 && x <= 2.0, "must be in (0, 2]")
+}

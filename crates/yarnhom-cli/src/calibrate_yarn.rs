@@ -4,18 +4,23 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use yarnhom_artifacts::{InputRef, Pattern, Provenance, container};
+use yarnhom_artifacts::open::open_artifact;
+use yarnhom_artifacts::report::{Report, read_report, write_report};
+use yarnhom_artifacts::{Pattern, Provenance, container};
+use yarnhom_calib::data::set::{MeasurementSet, PatternSource};
+use yarnhom_calib::optimize::swarm::SwarmSettings;
+use yarnhom_calib::shell::fit::{ShellFit, ShellFitSettings, fit_shell};
+use yarnhom_calib::yarn::fit::{best_start, fit_yarn};
+use yarnhom_calib::yarn::params::YarnBasis;
+use yarnhom_calib::yarn::problem::{RestShapeSettings, YarnFitEvent, YarnProblem};
+use yarnhom_calib::yarn::settings::{LocalSolver, YarnFitSettings};
+
 use yarnhom_calib::figures::yarn_fit_figure;
-use yarnhom_calib::measure::MeasurementSet;
-use yarnhom_calib::shell_fit::{ShellFit, ShellFitSettings, fit_shell};
-use yarnhom_calib::swarm::SwarmSettings;
-use yarnhom_calib::yarn_fit::{
-    LocalSolver, RestShapeSettings, YarnFit, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn,
-};
-use yarnhom_calib::yarn_params::YarnBasis;
 use yarnhom_figures::render_svg;
 
 use crate::Outcome;
+use crate::args::positive;
+use crate::output::write_bytes;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum LocalArg {
@@ -73,7 +78,7 @@ pub struct YarnArgs {
     pub start_from: Vec<PathBuf>,
     /// Stiffness of the stiffest yarn, k_s2 (N); default: the largest `stiffness_n` of the set's
     /// `[[yarn]]` entries, or fitted when none has one.
-    #[arg(long)]
+    #[arg(long, value_parser = positive)]
     pub yarn_stiffness: Option<f64>,
     /// Rest-shape resets per evaluation (Sec. 6.5.2).
     #[arg(long, default_value_t = 8)]
@@ -90,51 +95,48 @@ fn parse_shard(text: &str) -> Result<(u32, u32), String> {
     Ok((k, n))
 }
 
-/// Fibre density used when the set gives no linear density (kg/m³); statics do not use it.
-const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
+impl YarnArgs {
+    /// The fit's settings: a shard runs `1/N` of the particles with its own seed
+    /// ([`SwarmSettings::shard`]) and no local step.
+    fn settings(&self) -> YarnFitSettings {
+        let swarm = SwarmSettings {
+            particles: self.particles as usize,
+            generations: self.generations as usize,
+            seed: self.seed,
+            ..SwarmSettings::default()
+        };
+        YarnFitSettings {
+            swarm: self.shard.map_or(swarm, |(k, n)| swarm.shard(k, n)),
+            swarm_targets: self.swarm_targets as usize,
+            local_targets: self.local_targets as usize,
+            local: match (self.shard, self.local) {
+                (Some(_), _) | (None, LocalArg::None) => LocalSolver::None,
+                (None, LocalArg::Cobyla) => LocalSolver::Cobyla,
+                (None, LocalArg::Lm) => LocalSolver::LevenbergMarquardt,
+                (None, LocalArg::GaussNewton) => LocalSolver::GaussNewton,
+            },
+            local_budget: self.budget as usize,
+            rest: RestShapeSettings { max_length_change: 0.2, max_resets: self.max_resets as usize },
+            ..YarnFitSettings::default()
+        }
+    }
+}
 
 pub fn run(args: YarnArgs) -> Result<Outcome> {
-    if let Some(k) = args.yarn_stiffness {
-        anyhow::ensure!(k.is_finite() && k > 0.0, "--yarn-stiffness must be a positive force in newtons");
-    }
     let set = MeasurementSet::read(&args.set)?;
-    let pattern = set_pattern(&args.set, &set.fabric.pattern)?;
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("cannot create {}", args.output.display()))?;
+    let pattern = set_pattern(&args.set, &set)?;
+    create_dir(&args.output)?;
     let shell = match &args.shell_fit {
-        Some(path) => read_json::<ShellFit>(path)?,
+        Some(path) => read_report::<ShellFit>(path)?,
         None => {
             eprintln!("fitting the shell first ...");
             let fit = fit_shell(&set, &ShellFitSettings::default())?;
-            write_json(&args.output.join("shell-fit.json"), &fit)?;
+            write_report(&args.output.join("shell-fit.json"), &fit)?;
             fit
         }
     };
-    let basis = set_basis(&set, &pattern, args.yarn_stiffness);
-    let k_s2 = basis.k_s2_n;
-    let (particles, seed) = match args.shard {
-        Some((k, n)) => ((args.particles / n).max(1) as usize, args.seed.wrapping_add(u64::from(k) * 7919)),
-        None => (args.particles as usize, args.seed),
-    };
-    let settings = YarnFitSettings {
-        swarm: SwarmSettings {
-            particles,
-            generations: args.generations as usize,
-            seed,
-            ..SwarmSettings::default()
-        },
-        swarm_targets: args.swarm_targets as usize,
-        local_targets: args.local_targets as usize,
-        local: match (args.shard, args.local) {
-            (Some(_), _) | (None, LocalArg::None) => LocalSolver::None,
-            (None, LocalArg::Cobyla) => LocalSolver::Cobyla,
-            (None, LocalArg::Lm) => LocalSolver::LevenbergMarquardt,
-            (None, LocalArg::GaussNewton) => LocalSolver::GaussNewton,
-        },
-        local_budget: args.budget as usize,
-        rest: RestShapeSettings { max_length_change: 0.2, max_resets: args.max_resets as usize },
-        ..YarnFitSettings::default()
-    };
+    let basis = YarnBasis::of_set(&set, &pattern, args.yarn_stiffness);
+    let settings = args.settings();
     let problem = YarnProblem::from_shell_fit(pattern, basis, &shell, &set, &settings)?;
     let start = best_start(&args.start_from)?;
     eprintln!(
@@ -143,28 +145,15 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
         problem.pattern.name,
         problem.pattern.vertex_count(),
         basis.r_est_m * 1e3,
-        k_s2.map_or("fitted".to_string(), |k| format!("{k} N")),
+        basis.k_s2_n.map_or("fitted".to_string(), |k| format!("{k} N")),
     );
-    let progress = |event: YarnFitEvent| match event {
-        YarnFitEvent::Generation(g, best) => eprintln!("  swarm generation {g}: best g = {best:.5}"),
-        YarnFitEvent::LocalEvaluation(n, cost) => eprintln!("  local evaluation {n}: g = {cost:.5}"),
-    };
-    let fitted = fit_yarn(&problem, &set.fabric.name, &settings, start.as_deref(), &progress)?;
-    write_json(&args.output.join("yarn-fit.json"), &fitted.fit)?;
-    let from = vec![set_input(&args.set)?];
-    container::write(
-        args.output.join("yarn.yarnmodel.yh"),
-        &fitted.model,
-        &Provenance::of("calibrate yarn", from.clone()),
-    )?;
-    container::write(
-        args.output.join("rest.pattern.yh"),
-        &fitted.rest_pattern,
-        &Provenance::of("calibrate yarn", from),
-    )?;
-    std::fs::write(args.output.join("yarn-fit.svg"), render_svg(&yarn_fit_figure(&fitted.fit))?)
-        .with_context(|| format!("cannot write {}", args.output.join("yarn-fit.svg").display()))?;
-    println!("{}", summary(&fitted.fit));
+    let fitted = fit_yarn(&problem, &set.fabric.name, &settings, start.as_deref(), &print_progress)?;
+    write_report(&args.output.join("yarn-fit.json"), &fitted.fit)?;
+    let from = Provenance::of("calibrate yarn", vec![MeasurementSet::input_ref(&args.set)?]);
+    container::write(args.output.join("yarn.yarnmodel.yh"), &fitted.model, &from)?;
+    container::write(args.output.join("rest.pattern.yh"), &fitted.rest_pattern, &from)?;
+    write_bytes(&args.output.join("yarn-fit.svg"), render_svg(&yarn_fit_figure(&fitted.fit))?.as_bytes())?;
+    println!("{}", fitted.fit.summary());
     eprintln!(
         "wrote yarn-fit.json, yarn.yarnmodel.yh, rest.pattern.yh and yarn-fit.svg to {}",
         args.output.display()
@@ -172,107 +161,24 @@ pub fn run(args: YarnArgs) -> Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// The fixed quantities of a yarn-level fit of `set` on `pattern`: `k_s2` is `yarn_stiffness`,
-/// else the stiffest of the set's yarns, else fitted; the density from the yarns' linear density.
-pub(crate) fn set_basis(set: &MeasurementSet, pattern: &Pattern, yarn_stiffness: Option<f64>) -> YarnBasis {
-    let k_s2 =
-        yarn_stiffness.or_else(|| set.fabric.yarn.iter().filter_map(|y| y.stiffness_n).reduce(f64::max));
-    let radius = pattern.radius_range_m().0;
-    let tex = set.fabric.yarn.iter().find_map(|y| y.linear_density_tex);
-    let density = tex.map_or(DEFAULT_DENSITY_KG_M3, |t| t * 1e-6 / (std::f64::consts::PI * radius * radius));
-    YarnBasis::of_pattern(pattern, k_s2, density)
+/// Print a fit's progress.
+pub(crate) fn print_progress(event: YarnFitEvent) {
+    match event {
+        YarnFitEvent::Generation(g, best) => eprintln!("  swarm generation {g}: best g = {best:.5}"),
+        YarnFitEvent::LocalEvaluation(n, cost) => eprintln!("  local evaluation {n}: g = {cost:.5}"),
+    }
 }
 
-/// The set's input geometry: a pattern file (relative to the set directory, or as given) or a
-/// built-in generator at its default stitch size.
-pub(crate) fn set_pattern(set_dir: &Path, spec: &str) -> Result<Pattern> {
-    let candidates = [set_dir.join(spec), PathBuf::from(spec)];
-    if let Some(path) = candidates.iter().find(|p| p.is_file()) {
-        return Ok(yarnhom_artifacts::open::open_artifact::<Pattern>(path)?.value);
-    }
-    let params = yarnhom_pattern::GeneratorParams::defaults_for(spec).with_context(|| {
-        format!("pattern '{spec}' of {}: neither a file nor a generator", set_dir.display())
-    })?;
-    Ok(yarnhom_pattern::generate(spec, &params)?)
+/// Create the output directory.
+pub(crate) fn create_dir(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
 }
 
-/// The measurement set as a provenance input: the hash of its `fabric.toml` and `stretch.csv`.
-fn set_input(dir: &Path) -> Result<InputRef> {
-    let mut bytes = Vec::new();
-    for name in ["fabric.toml", "stretch.csv"] {
-        let path = dir.join(name);
-        bytes.extend(std::fs::read(&path).with_context(|| format!("cannot read {}", path.display()))?);
-    }
-    Ok(InputRef {
-        kind: "measurement-set".into(),
-        content_hash: container::content_hash(&bytes),
-        path: dir.display().to_string(),
+/// The input geometry of the set in `set_dir`: its pattern file, read like any input, or its
+/// built-in generator ([`yarnhom_calib::data::set::Fabric::pattern_source`]).
+pub(crate) fn set_pattern(set_dir: &Path, set: &MeasurementSet) -> Result<Pattern> {
+    Ok(match set.fabric.pattern_source(set_dir)? {
+        PatternSource::File(path) => open_artifact::<Pattern>(&path)?.value,
+        PatternSource::Generator { name, params } => yarnhom_pattern::generate(&name, &params)?,
     })
-}
-
-/// The best search point among earlier fits (lowest cost), if any are given.
-fn best_start(paths: &[PathBuf]) -> Result<Option<Vec<f64>>> {
-    let mut best: Option<YarnFit> = None;
-    for path in paths {
-        let fit: YarnFit = read_json(path)?;
-        if best.as_ref().is_none_or(|b| fit.cost < b.cost) {
-            best = Some(fit);
-        }
-    }
-    Ok(best.map(|b| b.coordinates))
-}
-
-fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    serde_json::from_str(&text).with_context(|| format!("{}: not a valid file of its kind", path.display()))
-}
-
-fn write_json<T: serde::Serialize>(path: &Path, value: &T) -> Result<()> {
-    std::fs::write(path, serde_json::to_string_pretty(value)?)
-        .with_context(|| format!("cannot write {}", path.display()))
-}
-
-/// The errors table and the estimated parameters.
-fn summary(fit: &YarnFit) -> String {
-    let p = &fit.params;
-    let mut lines = vec![
-        format!(
-            "yarn model of {} ({}), g = {:.5}, {:.1} s",
-            fit.fabric, fit.pattern, fit.cost, fit.wall_time_s
-        ),
-        format!(
-            "  k_s1 {:.4} N, k_s2 {:.4} N, eps_bar {:.4}, k_b {:.3e} N m², R_1 {:.4} mm, k_c1 {:.3e} N/m (R_2 {:.4} mm, k_c2 {:.3e} N/m)",
-            p.k_s1_n,
-            p.k_s2_n,
-            p.eps_bar,
-            p.k_b_nm2,
-            p.r1_m * 1e3,
-            p.k_c1_n_m,
-            p.r2_m * 1e3,
-            p.k_c2_n_m
-        ),
-        "  direction  comfort stress  power stress  compression".into(),
-    ];
-    for e in &fit.errors {
-        lines.push(format!(
-            "  {:<9}  {:>13.1}%  {:>12}  {:>10.1}%",
-            e.direction.as_str(),
-            100.0 * e.comfort_stress,
-            e.power_stress.map_or("-".into(), |x| format!("{:.1}%", 100.0 * x)),
-            100.0 * e.compression
-        ));
-    }
-    if let Some(s) = &fit.swarm {
-        lines.push(format!(
-            "  swarm: {} evaluations ({} failed), best g = {:.5}",
-            s.evaluations, s.failures, s.best_cost
-        ));
-    }
-    if let Some(l) = &fit.local {
-        lines.push(format!(
-            "  local ({:?}): g {:.5} -> {:.5} in {} evaluations, {:.1} s ({})",
-            l.solver, l.start_cost, l.cost, l.evaluations, l.wall_time_s, l.stop
-        ));
-    }
-    lines.join("\n")
 }

@@ -4,11 +4,11 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use yarnhom_calib::report::CalibrationReport;
 use clap::Args;
 use yarnhom_artifacts::AnyArtifact;
-use yarnhom_artifacts::diff::{Diff, Tolerance, diff, diff_documents};
+use yarnhom_artifacts::diff::{Tolerance, diff};
 use yarnhom_artifacts::open::{Contents, open};
+use yarnhom_calib::report::CalibrationReport;
 use yarnhom_fit::diff_spline_materials;
 use yarnhom_trace::{diff_traces, open_source};
 
@@ -62,7 +62,8 @@ pub fn run(args: DiffArgs) -> anyhow::Result<Outcome> {
             (serde_json::to_string_pretty(&d)?, d.report(), d.equal())
         }
         (Contents::Report(x), Contents::Report(y)) => {
-            let d = diff_reports(x.document, y.document, tol)?;
+            let d =
+                CalibrationReport::decode(x.document)?.diff(&CalibrationReport::decode(y.document)?, tol)?;
             (serde_json::to_string_pretty(&d)?, d.report(), d.equal())
         }
         (x, y) => anyhow::bail!(
@@ -79,13 +80,6 @@ pub fn run(args: DiffArgs) -> anyhow::Result<Outcome> {
         _ => {}
     }
     Ok(if equal { Outcome::Success } else { Outcome::Different })
-}
-
-/// Two calibration reports of one kind, each read through its migrations to the current version.
-fn diff_reports(a: serde_json::Value, b: serde_json::Value, tol: Tolerance) -> anyhow::Result<Diff> {
-    let (a, b) = (CalibrationReport::decode(a)?, CalibrationReport::decode(b)?);
-    anyhow::ensure!(a.format() == b.format(), "cannot compare a '{}' with a '{}'", a.format(), b.format());
-    Ok(diff_documents(a.format(), &a.to_document()?, &b.to_document()?, tol))
 }
 
 fn path_text(path: &Path) -> String {

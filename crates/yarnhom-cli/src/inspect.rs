@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 use yarnhom_artifacts::open::{Contents, Input, open};
 use yarnhom_artifacts::{AnyArtifact, Header, JsonDocument};
+use yarnhom_calib::report::CalibrationReport;
 
 use crate::Outcome;
 
@@ -29,10 +30,7 @@ pub fn run(args: InspectArgs) -> anyhow::Result<Outcome> {
     match contents {
         Contents::Artifact { header, artifact } => print_artifact(&header, &artifact)?,
         Contents::Membrane(m) => println!("{}", m.summary()),
-        Contents::Report(report) => {
-            let decoded = yarnhom_calib::report::CalibrationReport::decode(report.document)?;
-            println!("{}", decoded.summary());
-        }
+        Contents::Report(report) => println!("{}", CalibrationReport::decode(report.document)?.summary()),
         Contents::Trace => println!("an MCAP trace: `yarnhom trace info {}` summarizes it", path.display()),
     }
     Ok(Outcome::Success)

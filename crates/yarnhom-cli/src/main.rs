@@ -91,24 +91,6 @@ enum Command {
     Calibrate(calibrate::CalibrateCommand),
 }
 
-// TEMPORARY until the calib branch lands (never committed).
-#[allow(non_camel_case_types)]
-pub(crate) struct TEMP_REPORT(serde_json::Value);
-impl TEMP_REPORT {
-    pub(crate) fn decode(v: serde_json::Value) -> anyhow::Result<Self> {
-        Ok(Self(v))
-    }
-    pub(crate) fn summary(&self) -> String {
-        String::new()
-    }
-    pub(crate) fn format(&self) -> &str {
-        self.0["format"].as_str().unwrap_or_default()
-    }
-    pub(crate) fn to_document(&self) -> anyhow::Result<serde_json::Value> {
-        Ok(self.0.clone())
-    }
-}
-
 /// What a command reports back to `main`.
 enum Outcome {
     Success,

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Subcommand};
-use yarnhom_calib::MeasurementSet;
+use yarnhom_calib::data::set::MeasurementSet;
 
 use crate::Outcome;
 
@@ -48,7 +48,7 @@ pub fn run(cmd: MeasureCommand) -> anyhow::Result<Outcome> {
 #[cfg(feature = "hdf5")]
 fn import_stitch_by_stitch(args: ImportArgs) -> anyhow::Result<Outcome> {
     let every = usize::try_from(args.every)?;
-    let imported = yarnhom_calib::stitch_by_stitch::import_fabric(&args.inputs, every)?;
+    let imported = yarnhom_calib::data::stitch_by_stitch::import_fabric(&args.inputs, every)?;
     imported.set.write(&args.output)?;
     eprintln!("{}", imported.report());
     eprintln!("wrote {} ({} stretch points)", args.output.display(), imported.set.stretch.len());

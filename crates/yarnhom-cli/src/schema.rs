@@ -31,18 +31,18 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
         let reports = [
             (
                 "shell-fit",
-                yarnhom_calib::shell_fit::SHELL_FIT_VERSION,
-                yarnhom_calib::shell_fit::shell_fit_schema(),
+                yarnhom_calib::shell::fit::SHELL_FIT_VERSION,
+                yarnhom_calib::shell::fit::shell_fit_schema(),
             ),
             (
                 "diagnosis",
-                yarnhom_calib::diagnose::DIAGNOSIS_VERSION,
-                yarnhom_calib::diagnose::diagnosis_schema(),
+                yarnhom_calib::diagnosis::report::DIAGNOSIS_VERSION,
+                yarnhom_calib::diagnosis::report::diagnosis_schema(),
             ),
             (
                 "yarn-fit",
-                yarnhom_calib::yarn_fit::YARN_FIT_VERSION,
-                yarnhom_calib::yarn_fit::yarn_fit_schema(),
+                yarnhom_calib::yarn::fit::YARN_FIT_VERSION,
+                yarnhom_calib::yarn::fit::yarn_fit_schema(),
             ),
         ];
         for (name, version, schema) in reports {

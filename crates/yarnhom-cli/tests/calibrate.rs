@@ -3,8 +3,8 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use yarnhom_calib::measure::Direction;
-use yarnhom_calib::synth::{BendingPlan, GroundTruth, SynthPlan, synthesize};
+use yarnhom_calib::data::set::Direction;
+use yarnhom_calib::experiments::synth::{BendingPlan, GroundTruth, SynthPlan, synthesize};
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
 
 fn yarnhom(args: &[&str], cwd: &Path) -> Output {
@@ -86,7 +86,8 @@ fn bad_calibration_input_is_refused_with_a_reason() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("missing/fabric.toml"), "{}", text(&o.stderr));
     let o = yarnhom(&["calibrate", "shell", "missing", "-o", "out", "--force-cap=-1"], dir.path());
-    assert!(text(&o.stderr).contains("--force-cap must be a positive number"), "{}", text(&o.stderr));
+    let stderr = text(&o.stderr);
+    assert!(stderr.contains("'--force-cap") && stderr.contains("must be a positive"), "{stderr}");
 }
 
 #[test]
@@ -155,7 +156,8 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
     }
     let o = yarnhom(&["calibrate", "synth", "-o", "bad", "--effect", "none", "--noise=-1"], dir.path());
     assert_eq!(o.status.code(), Some(2));
-    assert!(text(&o.stderr).contains("--noise must be a number >= 0"), "{}", text(&o.stderr));
+    let stderr = text(&o.stderr);
+    assert!(stderr.contains("'--noise") && stderr.contains("must be a number >= 0"), "{stderr}");
 }
 
 #[test]
@@ -224,5 +226,6 @@ fn calibrate_yarn_estimates_a_yarn_model_in_shards_and_writes_its_artifacts() {
     assert_eq!(o.status.code(), Some(2));
     assert!(text(&o.stderr).contains("need 0 <= K < N"), "{}", text(&o.stderr));
     let o = yarnhom(&["calibrate", "yarn", "set", "-o", "x", "--yarn-stiffness=-1"], dir.path());
-    assert!(text(&o.stderr).contains("--yarn-stiffness must be a positive"), "{}", text(&o.stderr));
+    let stderr = text(&o.stderr);
+    assert!(stderr.contains("'--yarn-stiffness") && stderr.contains("must be a positive"), "{stderr}");
 }

@@ -12,7 +12,7 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use crate::measure::{Direction, MeasurementSet, Phase, StretchPoint};
+use crate::data::set::{Direction, MeasurementSet, Phase, StretchPoint};
 
 /// How the targets are chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -161,7 +161,7 @@ fn local_line(points: impl Iterator<Item = (f64, f64)>, at: f64) -> (f64, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::measure::Fabric;
+    use crate::data::set::Fabric;
 
     fn set(points: Vec<StretchPoint>) -> MeasurementSet {
         MeasurementSet {

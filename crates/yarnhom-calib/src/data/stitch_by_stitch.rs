@@ -47,7 +47,9 @@ use std::path::{Path, PathBuf};
 
 use ::hdf5::{File, Group};
 
-use crate::measure::{Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch, SwatchOverride, Yarn};
+use crate::data::set::{
+    Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch, SwatchOverride, Yarn,
+};
 
 /// Physical size of `/clampSize` (the clamp's short dimension), in metres.
 pub const CLAMP_SIZE_M: f64 = 0.0355;

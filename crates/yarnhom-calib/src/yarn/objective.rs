@@ -20,9 +20,9 @@ use yarnhom_rve::assembly::RveState;
 use yarnhom_rve::homogenize::stress_sensitivities;
 use yarnhom_shell::StvkNeoHookean;
 
-use crate::measure::Direction;
-use crate::uniform::uniaxial;
-use crate::yarn_tile::{TileError, TileSample, solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
+use super::tile::{TileError, TileSample, solve_uniaxial, uniaxial_strain, zero_orthogonal_stress};
+use crate::data::set::Direction;
+use crate::experiments::uniform::uniaxial;
 
 /// Smallest normalization of compression errors.
 pub const COMPRESSION_FLOOR: f64 = 0.02;

@@ -14,8 +14,8 @@ use yarnhom_rve::assembly::RveState;
 use yarnhom_rve::homogenize::{solve_at, stress_at_equilibrium};
 use yarnhom_rve::{RveModel, SolveOptions};
 
-use crate::measure::Direction;
-use crate::uniform::{first_form, pull_axis};
+use crate::data::set::Direction;
+use crate::experiments::uniform::{first_form, pull_axis};
 
 /// The in-plane strain `(sx, sa, sy)` (4.1) of a uniaxial state and its derivatives in `s` and `c`.
 #[derive(Debug, Clone, Copy, PartialEq)]

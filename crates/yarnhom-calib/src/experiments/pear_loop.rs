@@ -8,7 +8,7 @@
 //! its weight against its bending stiffness (the bending length `(B / w)^⅓`) sets how far it
 //! sags, which is what the test measures.
 //!
-//! The strip ([`crate::strip`]) is clamped at both ends. The loop starts from the shape
+//! The strip ([`super::strip`]) is clamped at both ends. The loop starts from the shape
 //! `θ(s) = α sin(2π s / L)` (tangent angle along the arc), whose ends are `L J₀(α)` apart with
 //! horizontal tangents, `α` chosen so that this is `d`, hanging downwards; then the static
 //! equilibrium with gravity is solved ([`yarnhom_shell::statics`]) with the (6.1) membrane and
@@ -16,7 +16,7 @@
 //!
 //! A uniform rest curvature `κ̄` does not change the loop: the bending energy
 //! `k ∫ (κ - κ̄)² ds = k ∫ κ² ds - 2 k κ̄ (θ(L) - θ(0)) + const`, and the clamps fix the
-//! tangents at both ends. (A curling fabric shows in the cantilever test, [`crate::cantilever`].)
+//! tangents at both ends. (A curling fabric shows in the cantilever test.)
 
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
@@ -24,8 +24,8 @@ use yarnhom_shell::statics::StaticError;
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
 use yarnhom_sparse::SpdSolver;
 
-use crate::measure::Direction;
-use crate::strip::{Clamps, Strip};
+use super::strip::{Clamps, Strip};
+use crate::data::set::Direction;
 
 /// A simulated pear-loop reading.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]

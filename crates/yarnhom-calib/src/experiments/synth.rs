@@ -1,18 +1,18 @@
 //! Synthetic measurement sets: the clamped stretch tests of a known membrane simulated
-//! ([`crate::swatch`]) at evenly spaced stretches, with Gaussian noise on the force and the
+//! ([`super::swatch`]) at evenly spaced stretches, with Gaussian noise on the force and the
 //! compression, and, if asked for, its bending tests (pear loops and cantilevers on both faces,
-//! [`crate::bending_fit`]) with noise on their readings; written as a real set would be. Fits
+//! [`super::bending_tests`]) with noise on their readings; written as a real set would be. Fits
 //! run on these must recover the truth, and a diagnosis must find the effect hidden in it
-//! ([`HiddenEffect`], [`ground_truth`]).
+//! ([`HiddenEffect`], [`ground_truth`]; [`SynthRequest`] is the set `calibrate synth` writes).
 
 use nalgebra::Vector2;
 use yarnhom_shell::{HingeBending, Stiffening, StvkNeoHookean};
 
-use crate::bending_fit::{BendingTests, group_mean_magnitudes};
-use crate::measure::{
+use super::bending_tests::{BendingTests, group_mean_magnitudes};
+use super::swatch::{SimulatedReading, SwatchError, SwatchTest};
+use crate::data::set::{
     BendingPoint, CantileverPoint, Direction, Fabric, Face, MeasurementSet, Phase, StretchPoint, Swatch,
 };
-use crate::swatch::{SimulatedReading, SwatchError, SwatchTest};
 
 /// An effect hidden in a synthetic set, beyond the plain anisotropic StVK base.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -61,78 +61,82 @@ impl GroundTruth {
 /// Bending stiffness of the base truth (J): a soft knit, whose pear loop responds to it.
 const BASE_BENDING_J: f64 = 1e-6;
 
+/// The membrane of the base truth: a knit-like anisotropic StVK (weft 60, warp 25 J/m²).
+const BASE_MEMBRANE: StvkNeoHookean = StvkNeoHookean {
+    k_xx: 60.0,
+    k_xy: 6.0,
+    k_yy: 25.0,
+    k_ss: 10.0,
+    k_n1: 0.0,
+    k_n2: 0.0,
+    stiffening: None,
+    jamming: None,
+};
+
 /// The truth of a synthetic set: a knit-like anisotropic StVK (weft 60, warp 25 J/m²) and an
 /// isotropic, flat bending of 1e-6 J, with `effect` at `strength` (1: clearly visible at 2%
 /// noise).
 pub fn ground_truth(effect: HiddenEffect, strength: f64) -> GroundTruth {
-    let membrane = StvkNeoHookean {
-        k_xx: 60.0,
-        k_xy: 6.0,
-        k_yy: 25.0,
-        k_ss: 10.0,
-        k_n1: 0.0,
-        k_n2: 0.0,
-        stiffening: None,
-        jamming: None,
-    };
-    let base =
-        GroundTruth { membrane, unload_friction: 0.0, bending: HingeBending::isotropic(BASE_BENDING_J) };
+    let base = GroundTruth::of_membrane(BASE_MEMBRANE);
     match effect {
         HiddenEffect::None => base,
-        HiddenEffect::AreaPreservation => GroundTruth {
-            membrane: StvkNeoHookean { k_n1: 40.0 * strength, k_n2: 40.0 * strength, ..membrane },
-            ..base
-        },
-        HiddenEffect::BiphasicStretch => GroundTruth {
-            membrane: StvkNeoHookean {
-                stiffening: Some(Stiffening {
-                    k_weft: 240.0 * strength,
-                    k_warp: 100.0 * strength,
-                    onset: 0.08,
-                }),
-                ..membrane
-            },
-            ..base
-        },
-        HiddenEffect::TwoPhaseContact => GroundTruth {
-            membrane: StvkNeoHookean {
-                jamming: Some(Stiffening { k_weft: 400.0 * strength, k_warp: 400.0 * strength, onset: 0.02 }),
-                ..membrane
-            },
-            ..base
-        },
         HiddenEffect::FrictionHysteresis => GroundTruth { unload_friction: 0.08 * strength, ..base },
-        HiddenEffect::Softening => GroundTruth {
-            membrane: StvkNeoHookean {
-                stiffening: Some(Stiffening {
-                    k_weft: -0.7 * strength.min(1.0) * membrane.k_xx,
-                    k_warp: -0.7 * strength.min(1.0) * membrane.k_yy,
-                    onset: 0.03,
-                }),
-                ..membrane
-            },
-            ..base
+        HiddenEffect::RestCurvature | HiddenEffect::AnisotropicBending => {
+            GroundTruth { bending: hidden_bending(effect, strength), ..base }
+        }
+        HiddenEffect::AreaPreservation
+        | HiddenEffect::BiphasicStretch
+        | HiddenEffect::TwoPhaseContact
+        | HiddenEffect::Softening => GroundTruth { membrane: hidden_membrane(effect, strength), ..base },
+    }
+}
+
+/// The base membrane with a membrane `effect` at `strength`.
+fn hidden_membrane(effect: HiddenEffect, strength: f64) -> StvkNeoHookean {
+    let membrane = BASE_MEMBRANE;
+    match effect {
+        HiddenEffect::AreaPreservation => {
+            StvkNeoHookean { k_n1: 40.0 * strength, k_n2: 40.0 * strength, ..membrane }
+        }
+        HiddenEffect::BiphasicStretch => StvkNeoHookean {
+            stiffening: Some(Stiffening { k_weft: 240.0 * strength, k_warp: 100.0 * strength, onset: 0.08 }),
+            ..membrane
         },
+        HiddenEffect::TwoPhaseContact => StvkNeoHookean {
+            jamming: Some(Stiffening { k_weft: 400.0 * strength, k_warp: 400.0 * strength, onset: 0.02 }),
+            ..membrane
+        },
+        HiddenEffect::Softening => StvkNeoHookean {
+            stiffening: Some(Stiffening {
+                k_weft: -0.7 * strength.min(1.0) * membrane.k_xx,
+                k_warp: -0.7 * strength.min(1.0) * membrane.k_yy,
+                onset: 0.03,
+            }),
+            ..membrane
+        },
+        _ => membrane,
+    }
+}
+
+/// The base truth's isotropic flat bending with a bending `effect` at `strength`.
+fn hidden_bending(effect: HiddenEffect, strength: f64) -> HingeBending {
+    let base = HingeBending::isotropic(BASE_BENDING_J);
+    match effect {
         HiddenEffect::RestCurvature => {
             let curl = 25.0 * strength;
-            GroundTruth {
-                bending: HingeBending {
-                    rest_curvature_weft: curl,
-                    rest_curvature_bias: curl,
-                    rest_curvature_warp: curl,
-                    ..base.bending
-                },
+            HingeBending {
+                rest_curvature_weft: curl,
+                rest_curvature_bias: curl,
+                rest_curvature_warp: curl,
                 ..base
             }
         }
-        HiddenEffect::AnisotropicBending => GroundTruth {
-            bending: HingeBending::anisotropic(
-                BASE_BENDING_J * (1.0 + 3.0 * strength),
-                BASE_BENDING_J * (1.0 + 1.5 * strength),
-                BASE_BENDING_J,
-            ),
-            ..base
-        },
+        HiddenEffect::AnisotropicBending => HingeBending::anisotropic(
+            BASE_BENDING_J * (1.0 + 3.0 * strength),
+            BASE_BENDING_J * (1.0 + 1.5 * strength),
+            BASE_BENDING_J,
+        ),
+        _ => base,
     }
 }
 
@@ -300,6 +304,61 @@ fn add_bending_tests(
         p.tip_drop_m = r.clamp(-p.overhang_m, p.overhang_m);
     }
     Ok(())
+}
+
+/// Areal density of synthetic sets with bending tests (kg/m²): a mid-weight knit.
+pub const SYNTH_AREAL_DENSITY_KG_M2: f64 = 0.25;
+
+/// The synthetic set `yarnhom calibrate synth` writes: `effect` hidden at `strength`, 120
+/// loading and unloading readings per direction up to `max_stretch`, the noise `noise` times the
+/// clean set's mean |force| and mean |compression|, and the bending tests
+/// ([`BendingPlan::default`], the same relative noise, [`SYNTH_AREAL_DENSITY_KG_M2`]) when
+/// asked for or when the effect is a bending one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SynthRequest {
+    /// The fabric's name.
+    pub name: String,
+    /// The effect hidden in the data.
+    pub effect: HiddenEffect,
+    /// Its strength (1: clearly visible at 2% noise).
+    pub strength: f64,
+    /// Standard deviation of the noise, as a fraction of the mean clean value.
+    pub noise: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+    /// Largest stretch of every direction.
+    pub max_stretch: f64,
+    /// Bending tests too.
+    pub bending_tests: bool,
+}
+
+impl SynthRequest {
+    /// The truth and its noisy set (the clean set is simulated first, to scale the noise).
+    pub fn synthesize(&self) -> Result<(GroundTruth, MeasurementSet), SynthError> {
+        let truth = ground_truth(self.effect, self.strength);
+        let bending_tests = self.bending_tests
+            || matches!(self.effect, HiddenEffect::RestCurvature | HiddenEffect::AnisotropicBending);
+        let mut clean_plan = SynthPlan {
+            readings: 120,
+            unload: true,
+            bending: bending_tests.then(|| BendingPlan { noise: self.noise, ..BendingPlan::default() }),
+            ..SynthPlan::new(&self.name, self.max_stretch)
+        };
+        if bending_tests {
+            clean_plan.fabric.swatch.areal_density_kg_m2 = Some(SYNTH_AREAL_DENSITY_KG_M2);
+        }
+        let clean = synthesize(&truth, &clean_plan)?;
+        let mean = |f: &dyn Fn(&StretchPoint) -> f64| {
+            clean.stretch.iter().map(|p| f(p).abs()).sum::<f64>() / clean.stretch.len() as f64
+        };
+        let plan = SynthPlan {
+            force_noise_n: self.noise * mean(&|p| p.force_n),
+            compression_noise: self.noise * mean(&|p| p.compression.unwrap_or(0.0)),
+            seed: self.seed,
+            ..clean_plan
+        };
+        Ok((truth, synthesize(&truth, &plan)?))
+    }
 }
 
 /// Standard normal samples: splitmix64 uniforms through Box-Muller (reproducible per seed on

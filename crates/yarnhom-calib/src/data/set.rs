@@ -18,6 +18,9 @@ use std::path::{Path, PathBuf};
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use yarnhom_artifacts::InputRef;
+use yarnhom_artifacts::container::content_hash;
+use yarnhom_pattern::{GenerateError, GeneratorParams};
 
 /// File name of the fabric description in a measurement set.
 pub const FABRIC_FILE: &str = "fabric.toml";
@@ -92,6 +95,17 @@ pub enum MeasureError {
         /// The file.
         path: PathBuf,
     },
+    /// `fabric.toml`'s `pattern` names neither a file nor a built-in generator.
+    #[error("pattern '{spec}' of {}: neither a file nor a generator", dir.display())]
+    Pattern {
+        /// The measurement set's directory.
+        dir: PathBuf,
+        /// The `pattern` field.
+        spec: String,
+        /// Why it is not a generator.
+        #[source]
+        source: GenerateError,
+    },
 }
 
 /// Result type of this module.
@@ -125,6 +139,16 @@ impl Direction {
     /// The direction named `name` (`weft`, `bias` or `warp`), if any.
     pub fn parse(name: &str) -> Option<Direction> {
         Direction::ALL.into_iter().find(|d| d.as_str() == name)
+    }
+
+    /// Per-direction values, in [`Direction::ALL`] order, given as one value for every direction
+    /// or as three (weft, bias, warp); `None` for any other count.
+    pub fn per_direction(values: &[f64]) -> Option<[f64; 3]> {
+        match *values {
+            [v] => Some([v; 3]),
+            [weft, bias, warp] => Some([weft, bias, warp]),
+            _ => None,
+        }
     }
 }
 
@@ -217,6 +241,38 @@ pub struct Fabric {
     /// The yarns the fabric is made of, if known.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub yarn: Vec<Yarn>,
+}
+
+/// Where a set's input yarn geometry comes from: [`Fabric::pattern`] resolved.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PatternSource {
+    /// A pattern file (`.pattern.yh`, a JSON document, an HDF5 export or a `.pyp`).
+    File(PathBuf),
+    /// A built-in generator at its default stitch size.
+    Generator {
+        /// The generator's name.
+        name: String,
+        /// Its default parameters.
+        params: GeneratorParams,
+    },
+}
+
+impl Fabric {
+    /// The input geometry of the set in `set_dir`: the file `pattern` names (relative to the
+    /// set's directory, or as given), else the built-in generator of that name.
+    pub fn pattern_source(&self, set_dir: &Path) -> Result<PatternSource> {
+        let spec = &self.pattern;
+        let candidates = [set_dir.join(spec), PathBuf::from(spec)];
+        if let Some(path) = candidates.into_iter().find(|p| p.is_file()) {
+            return Ok(PatternSource::File(path));
+        }
+        let params = GeneratorParams::defaults_for(spec).map_err(|source| MeasureError::Pattern {
+            dir: set_dir.to_path_buf(),
+            spec: spec.clone(),
+            source,
+        })?;
+        Ok(PatternSource::Generator { name: spec.clone(), params })
+    }
 }
 
 /// `[swatch]`: the tested piece of fabric, and where its deformation was read.
@@ -449,6 +505,21 @@ impl MeasurementSet {
         )
     }
 
+    /// The set in directory `dir` as a provenance input: kind `measurement-set`, the content
+    /// hash of its `fabric.toml` and `stretch.csv` bytes, in that order.
+    pub fn input_ref(dir: &Path) -> Result<InputRef> {
+        let mut bytes = Vec::new();
+        for name in [FABRIC_FILE, STRETCH_FILE] {
+            let path = dir.join(name);
+            bytes.extend(std::fs::read(&path).map_err(|error| MeasureError::Io { path, error })?);
+        }
+        Ok(InputRef {
+            kind: "measurement-set".into(),
+            content_hash: content_hash(&bytes),
+            path: dir.display().to_string(),
+        })
+    }
+
     /// A human summary: the fabric, then points per direction and phase with their stretch and
     /// force ranges, then the bending points per direction.
     pub fn summary(&self) -> String {
@@ -592,6 +663,25 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
     if fabric.pattern.trim().is_empty() {
         return Err(field_error("pattern".into(), "must not be empty"));
     }
+    for (field, value) in positive_fields(fabric) {
+        if value.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+            return Err(field_error(field, "must be a finite number > 0"));
+        }
+    }
+    if let Some((field, message)) = gauge_problem(&fabric.swatch) {
+        return Err(field_error(field, message));
+    }
+    for (i, yarn) in fabric.yarn.iter().enumerate() {
+        if yarn.mass_fraction.is_some_and(|m| m > 1.0) {
+            return Err(field_error(format!("yarn[{i}].mass_fraction"), "must be at most 1"));
+        }
+    }
+    Ok(())
+}
+
+/// The fields of `fabric` that must be finite numbers > 0 where given, by TOML path, in the
+/// order they are checked.
+fn positive_fields(fabric: &Fabric) -> Vec<(String, Option<f64>)> {
     let swatch = &fabric.swatch;
     let mut positive = vec![
         ("swatch.length_m".to_string(), Some(swatch.length_m)),
@@ -614,11 +704,11 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
         positive.push((format!("yarn[{i}].stiffness_n"), yarn.stiffness_n));
         positive.push((format!("yarn[{i}].mass_fraction"), yarn.mass_fraction));
     }
-    for (field, value) in positive {
-        if value.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
-            return Err(field_error(field, "must be a finite number > 0"));
-        }
-    }
+    positive
+}
+
+/// The first marker gauge longer than its direction's swatch: the field and what is wrong.
+fn gauge_problem(swatch: &Swatch) -> Option<(String, &'static str)> {
     for direction in Direction::ALL {
         let specimen = swatch.specimen(direction);
         let prefix = if swatch.override_for(direction).is_some() {
@@ -627,24 +717,13 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
             "swatch".into()
         };
         if specimen.stretch_gauge_m.is_some_and(|g| g > specimen.length_m) {
-            return Err(field_error(
-                format!("{prefix}.stretch_gauge_m"),
-                "must be at most the swatch length",
-            ));
+            return Some((format!("{prefix}.stretch_gauge_m"), "must be at most the swatch length"));
         }
         if specimen.compression_gauge_m.is_some_and(|g| g > specimen.width_m) {
-            return Err(field_error(
-                format!("{prefix}.compression_gauge_m"),
-                "must be at most the swatch width",
-            ));
+            return Some((format!("{prefix}.compression_gauge_m"), "must be at most the swatch width"));
         }
     }
-    for (i, yarn) in fabric.yarn.iter().enumerate() {
-        if yarn.mass_fraction.is_some_and(|m| m > 1.0) {
-            return Err(field_error(format!("yarn[{i}].mass_fraction"), "must be at most 1"));
-        }
-    }
-    Ok(())
+    None
 }
 
 /// A CSV file split into a header and rows of fields (no quoting: the format needs none).

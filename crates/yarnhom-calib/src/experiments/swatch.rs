@@ -19,8 +19,8 @@ use yarnhom_shell::statics::{StaticError, StaticSettings, solve_static};
 use yarnhom_shell::{ShellMesh, StvkNeoHookean};
 use yarnhom_sparse::SpdSolver;
 
-use crate::measure::{Direction, Specimen};
-use crate::uniform::direction_angle;
+use super::uniform::direction_angle;
+use crate::data::set::{Direction, Specimen};
 
 /// A simulated reading of the stretch test.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
@@ -264,8 +264,8 @@ fn locate(mesh: &ShellMesh, p: Vector2<f64>) -> Marker {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiments::uniform::uniaxial;
     use crate::test_support::knit_membrane as material;
-    use crate::uniform::uniaxial;
 
     fn specimen(length_m: f64, width_m: f64) -> Specimen {
         Specimen { length_m, width_m, stretch_gauge_m: None, compression_gauge_m: None }

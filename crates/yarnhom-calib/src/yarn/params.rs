@@ -24,6 +24,11 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel};
 
+use crate::data::set::MeasurementSet;
+
+/// Fibre density used when the set gives no linear density (kg/m³); statics do not use it.
+pub const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
+
 /// The inner barrier of the two-phase contact (6.7).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
@@ -138,6 +143,19 @@ impl YarnBasis {
             density_kg_m3,
             mechanisms: YarnMechanisms::THESIS,
         }
+    }
+
+    /// The basis of a yarn-level fit of `set` on `pattern`: `k_s2` is `yarn_stiffness`, else the
+    /// stiffest of the set's yarns, else fitted; the density from the yarns' linear density
+    /// (else [`DEFAULT_DENSITY_KG_M3`]).
+    pub fn of_set(set: &MeasurementSet, pattern: &Pattern, yarn_stiffness: Option<f64>) -> Self {
+        let k_s2 =
+            yarn_stiffness.or_else(|| set.fabric.yarn.iter().filter_map(|y| y.stiffness_n).reduce(f64::max));
+        let radius = pattern.radius_range_m().0;
+        let tex = set.fabric.yarn.iter().find_map(|y| y.linear_density_tex);
+        let density =
+            tex.map_or(DEFAULT_DENSITY_KG_M3, |t| t * 1e-6 / (std::f64::consts::PI * radius * radius));
+        YarnBasis::of_pattern(pattern, k_s2, density)
     }
 
     /// The same basis fitting `mechanisms`.

@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 use yarnhom_shell::StvkNeoHookean;
 use yarnhom_shell::material::membrane_jet;
 
-use crate::measure::Direction;
+use crate::data::set::Direction;
 
 /// The angle of a test direction from the weft (material x), in radians.
 pub fn direction_angle(direction: Direction) -> f64 {

@@ -1,18 +1,18 @@
-//! The yarn-level confirmation of a diagnosed cause: the diagnosis screens its catalog cheaply
-//! at the shell level ([`crate::diagnose`]), then a cause that has a mechanism in the Ch. 6 yarn
-//! model is confirmed on the periodic tile with the yarn-level fit of Sec. 6.5.
+//! The yarn-level confirmation of a diagnosed cause: the diagnosis screens its catalog
+//! ([`crate::cause`]) cheaply at the shell level, then a cause that has a mechanism in the Ch. 6
+//! yarn model is confirmed on the periodic tile with the yarn-level fit of Sec. 6.5.
 //!
-//! 1. Targets: the uniform tests (6.3) of the **extended** shell, the membrane with the
-//!    diagnosed extension, along every tested direction (the thesis' route from measurements to
-//!    the yarn level); `n` fitted targets per direction, and `n` held out at the midpoints
-//!    between them.
+//! 1. Targets: the problem's, in the diagnosis the uniform tests (6.3) of the **extended**
+//!    shell, the membrane with the diagnosed extension, along every tested direction (the
+//!    thesis' route from measurements to the yarn level); `n` fitted targets per direction, and
+//!    `n` held out at the midpoints between them.
 //! 2. Models, nested: the base of Sec. 6.4 (linear yarn stretch `k_s1 = k_s2`, single-phase
 //!    contact `k_c2 = 0`, [`YarnMechanisms::BASE`]) and the base plus the cause's mechanism:
 //!    the biphasic stretch (6.5) for `biphasic-stretch`, a fitted inner contact barrier (6.7)
 //!    for `two-phase-contact`.
 //! 3. Fits, with the same swarm and local budget for both: the base by swarm and local step; the
 //!    extension by a swarm seeded with the base's optimum (its new mechanism switched on at no
-//!    effect, [`YarnBasis::embed`]: a nested local start alone stays in the base's basin, where
+//!    effect, [`super::params::YarnBasis::embed`]: a nested local start alone stays in the base's basin, where
 //!    e.g. a stiff linear yarn is compensated by soft contacts), then a local step; then the
 //!    base once more, by a local step from the extension's optimum with the mechanism off, so
 //!    that a better basin found by the extension's search is open to the base as well and only
@@ -20,8 +20,8 @@
 //! 4. Verdict: the mechanism is confirmed when the base misses the held-out targets by more than
 //!    [`MIN_BASE_ERROR`] (else the stitch geometry already explains the effect), the extension's
 //!    held-out error is below [`CONFIRM_RATIO`] of the base's, and its Akaike criterion on the
-//!    fitted targets is lower by more than 4: the shell-level rules, without a noise term (the
-//!    targets are a smooth model's).
+//!    fitted targets is lower by more than [`MIN_CRITERION_DROP`]: the shell-level rules, without
+//!    a noise term (the targets are a smooth model's).
 //!
 //! The other causes have no counterpart in the yarn model (area preservation and bending
 //! anisotropy emerge from the stitch geometry, rest curvature from the rest shape, and the
@@ -32,19 +32,16 @@ use std::time::Instant;
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_artifacts::Pattern;
-use yarnhom_shell::StvkNeoHookean;
+use yarnhom_geom::stats::root_mean_square;
 
-use crate::diagnose::{CauseId, Diagnosis, criterion};
-use crate::measure::{Direction, MeasurementSet};
-use crate::shell_fit::rms;
-use crate::swarm::SwarmSettings;
-use crate::yarn_fit::{
-    LocalSolver, TargetSource, YarnFitError, YarnFitEvent, YarnFitSettings, YarnProblem, fit_yarn,
-    global_step,
-};
-use crate::yarn_objective::{DirectionTargets, YarnErrors, errors, residuals};
-use crate::yarn_params::{InnerContact, YarnBasis, YarnMechanisms, YarnParams};
+use super::fit::{fit_yarn, global_step};
+use super::objective::{DirectionTargets, YarnErrors, errors, residuals};
+use super::params::{InnerContact, YarnMechanisms, YarnParams};
+use super::problem::{YarnFitError, YarnFitEvent, YarnProblem};
+use super::settings::{LocalSolver, YarnFitSettings};
+use crate::cause::CauseId;
+use crate::optimize::akaike::criterion;
+use crate::optimize::swarm::SwarmSettings;
 
 /// The extension must bring the base's held-out error below this fraction of it.
 pub const CONFIRM_RATIO: f64 = 0.75;
@@ -53,7 +50,7 @@ pub const CONFIRM_RATIO: f64 = 0.75;
 pub const MIN_BASE_ERROR: f64 = 0.03;
 
 /// The Akaike criterion must drop by more than this.
-const MIN_CRITERION_DROP: f64 = 4.0;
+pub const MIN_CRITERION_DROP: f64 = 4.0;
 
 /// How large the confirmation's search is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -233,8 +230,8 @@ fn fit_and_score(
         coordinate_names: fit.coordinate_names.clone(),
         coordinates: fit.coordinates.clone(),
         params: fit.params,
-        error: rms(&fitted_residuals),
-        heldout_error: rms(&residuals(heldout, &on_heldout.curves)),
+        error: root_mean_square(fitted_residuals.iter().copied()),
+        heldout_error: root_mean_square(residuals(heldout, &on_heldout.curves)),
         criterion: criterion(&fitted_residuals, fit.coordinates.len()),
         errors: errors(&fit.targets, &fit.simulated),
         evaluations: fit.local.as_ref().map_or(0, |l| l.evaluations),
@@ -269,9 +266,9 @@ fn verdict(cause: CauseId, base: &YarnLevelModel, extended: &YarnLevelModel) -> 
         (true, format!("confirmed at the yarn level: {numbers}"))
     } else {
         let why = if gains {
-            "the criterion does not drop by more than 4"
+            format!("the criterion does not drop by more than {MIN_CRITERION_DROP}")
         } else {
-            "the held-out error does not drop below 75% of the base's"
+            format!("the held-out error does not drop below {:.0}% of the base's", 100.0 * CONFIRM_RATIO)
         };
         (false, format!("not confirmed at the yarn level ({why}): {numbers}"))
     }
@@ -284,64 +281,10 @@ pub fn skipped(cause: CauseId) -> Option<YarnLevel> {
         .then(|| YarnLevel::NotRun { reason: format!("{}: {}", cause.as_str(), no_mechanism_reason(cause)) })
 }
 
-/// The confirmation of `diagnosis`'s cause on `pattern`: targets from the extended shell's
-/// uniform tests along the set's tested directions, up to the largest target stretch of each.
-pub fn confirm_diagnosis(
-    set: &MeasurementSet,
-    diagnosis: &Diagnosis,
-    pattern: Pattern,
-    basis: YarnBasis,
-    settings: &YarnFitSettings,
-    progress: &(dyn Fn(YarnFitEvent) + Sync),
-) -> YarnLevel {
-    let cause = diagnosis.cause.id;
-    if let Some(skipped) = skipped(cause) {
-        return skipped;
-    }
-    let Some(material) = diagnosis.extended_material else {
-        return YarnLevel::NotRun { reason: "the diagnosis has no extended shell material".into() };
-    };
-    let problem = shell_problem(set, diagnosis, pattern, basis, material, settings);
-    match confirm(&problem, cause, settings, progress) {
-        Ok(c) => YarnLevel::Confirmation(Box::new(c)),
-        Err(e) => YarnLevel::NotRun { reason: format!("the yarn-level fit failed: {e}") },
-    }
-}
-
-/// The yarn-level problem of the extended shell `material` along the diagnosis's directions.
-fn shell_problem(
-    set: &MeasurementSet,
-    diagnosis: &Diagnosis,
-    pattern: Pattern,
-    basis: YarnBasis,
-    material: StvkNeoHookean,
-    settings: &YarnFitSettings,
-) -> YarnProblem {
-    let directions = Direction::ALL
-        .into_iter()
-        .filter_map(|d| {
-            let largest = diagnosis
-                .load_targets
-                .iter()
-                .filter(|t| t.direction == d)
-                .map(|t| t.stretch)
-                .fold(0.0, f64::max);
-            (largest > 0.0).then(|| (d, largest, set.fabric.swatch.specimen(d).width_m))
-        })
-        .collect();
-    YarnProblem {
-        pattern,
-        basis,
-        source: TargetSource::Shell(material),
-        directions,
-        rest: settings.rest,
-        comfort_force_n: settings.comfort_force_n,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::yarn::params::YarnBasis;
 
     fn model(heldout_error: f64, criterion: f64) -> YarnLevelModel {
         let basis = YarnBasis {

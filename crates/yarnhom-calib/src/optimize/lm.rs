@@ -82,31 +82,9 @@ where
         let Some(jacobian) = jacobian else { break };
         let normal = jacobian.transpose() * &jacobian;
         let gradient = jacobian.transpose() * &r;
-        let floor = 1e-12 * normal.diagonal().max().max(1e-300);
-        let accepted = loop {
-            let mut damped = normal.clone();
-            for i in 0..p.len() {
-                damped[(i, i)] += damping * normal[(i, i)].max(floor);
-            }
-            let Some(step) = damped.cholesky().map(|c| c.solve(&(-&gradient))) else {
-                damping *= 10.0;
-                continue;
-            };
-            let trial = &p + &step;
-            report.evaluations += 1;
-            if let Some(rt) = residuals(trial.as_slice()).map(DVector::from_vec) {
-                let cost = 0.5 * rt.norm_squared();
-                if cost < report.cost {
-                    damping = (damping / 3.0).max(1e-9);
-                    break Some((trial, rt, cost));
-                }
-            }
-            damping *= 4.0;
-            if damping > 1e10 {
-                break None;
-            }
-        };
-        let Some((trial, rt, cost)) = accepted else {
+        let step = DampedStep { normal: &normal, gradient: &gradient, cost: report.cost };
+        let Some((trial, rt, cost)) = step.accept(&residuals, &p, &mut damping, &mut report.evaluations)
+        else {
             report.converged = true;
             break;
         };
@@ -119,6 +97,56 @@ where
     }
     report.params = p.as_slice().to_vec();
     Some(report)
+}
+
+/// The normal equations of one iteration and the cost to beat.
+struct DampedStep<'a> {
+    normal: &'a DMatrix<f64>,
+    gradient: &'a DVector<f64>,
+    cost: f64,
+}
+
+impl DampedStep<'_> {
+    /// The first damped Gauss-Newton step from `p` that lowers the cost, with its residuals and
+    /// cost: the damping grows (x10 where the damped matrix is not positive definite, x4 where
+    /// the step fails or does not lower the cost) until a step is accepted, then shrinks by 3;
+    /// `None` once it passes 1e10. `evaluations` counts the residual evaluations.
+    fn accept<F>(
+        &self,
+        residuals: &F,
+        p: &DVector<f64>,
+        damping: &mut f64,
+        evaluations: &mut usize,
+    ) -> Option<(DVector<f64>, DVector<f64>, f64)>
+    where
+        F: Fn(&[f64]) -> Option<Vec<f64>>,
+    {
+        let normal = self.normal;
+        let floor = 1e-12 * normal.diagonal().max().max(1e-300);
+        loop {
+            let mut damped = normal.clone();
+            for i in 0..p.len() {
+                damped[(i, i)] += *damping * normal[(i, i)].max(floor);
+            }
+            let Some(step) = damped.cholesky().map(|c| c.solve(&(-self.gradient))) else {
+                *damping *= 10.0;
+                continue;
+            };
+            let trial = p + &step;
+            *evaluations += 1;
+            if let Some(rt) = residuals(trial.as_slice()).map(DVector::from_vec) {
+                let cost = 0.5 * rt.norm_squared();
+                if cost < self.cost {
+                    *damping = (*damping / 3.0).max(1e-9);
+                    return Some((trial, rt, cost));
+                }
+            }
+            *damping *= 4.0;
+            if *damping > 1e10 {
+                return None;
+            }
+        }
+    }
 }
 
 /// Forward differences `(r(p + h e_j) - r(p)) / h`, columns in parallel (a column whose

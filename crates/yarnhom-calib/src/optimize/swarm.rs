@@ -46,6 +46,18 @@ impl Default for SwarmSettings {
     }
 }
 
+impl SwarmSettings {
+    /// Shard `k` of `n` independent sub-swarms of these settings: `n` times fewer particles (at
+    /// least one) and the seed offset by `7919 k`, so the shards search apart.
+    pub fn shard(self, k: u32, n: u32) -> Self {
+        SwarmSettings {
+            particles: (self.particles / n as usize).max(1),
+            seed: self.seed.wrapping_add(u64::from(k) * 7919),
+            ..self
+        }
+    }
+}
+
 /// The result of a swarm run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SwarmReport {
@@ -87,24 +99,15 @@ pub fn minimize<F>(
 where
     F: Fn(&[f64]) -> Option<f64> + Sync,
 {
-    let dim = bounds.len();
     let mut random = Uniform(settings.seed);
     let to_problem =
         |u: &[f64]| -> Vec<f64> { u.iter().zip(bounds).map(|(x, (lo, hi))| lo + x * (hi - lo)).collect() };
-    let mut position: Vec<Vec<f64>> =
-        (0..settings.particles).map(|_| (0..dim).map(|_| random.next()).collect()).collect();
-    for (p, seed) in position.iter_mut().zip(seeds) {
-        *p = seed.iter().zip(bounds).map(|(x, (lo, hi))| ((x - lo) / (hi - lo)).clamp(0.0, 1.0)).collect();
-    }
-    let mut velocity: Vec<Vec<f64>> =
-        (0..settings.particles).map(|_| (0..dim).map(|_| 0.2 * (random.next() - 0.5)).collect()).collect();
     let evaluate = |points: &[Vec<f64>]| -> Vec<f64> {
         points
             .par_iter()
             .map(|u| cost(&to_problem(u)).filter(|c| c.is_finite()).unwrap_or(f64::INFINITY))
             .collect()
     };
-    let mut costs = evaluate(&position);
     let mut report = SwarmReport {
         best: Vec::new(),
         best_cost: f64::INFINITY,
@@ -112,34 +115,96 @@ where
         evaluations: 0,
         failures: 0,
     };
-    let count = |report: &mut SwarmReport, costs: &[f64]| {
-        report.evaluations += costs.len();
-        report.failures += costs.iter().filter(|c| c.is_infinite()).count();
-    };
-    count(&mut report, &costs);
-    let mut own_best = position.clone();
-    let mut own_cost = costs.clone();
-    let best_of = |own_cost: &[f64]| {
-        own_cost.iter().enumerate().fold(0, |b, (i, c)| if *c < own_cost[b] { i } else { b })
-    };
-    let mut best = best_of(&own_cost);
-    report.history.push(own_cost[best]);
-    progress(0, own_cost[best]);
+    let (position, velocity) = Swarm::start(bounds, settings.particles, seeds, &mut random);
+    let costs = evaluate(&position);
+    report.count(&costs);
+    let mut swarm = Swarm::new(position, velocity, costs);
+    report.history.push(swarm.best_cost());
+    progress(0, swarm.best_cost());
     for generation in 1..=settings.generations {
+        swarm.fly(settings, generation, &mut random);
+        let costs = evaluate(&swarm.position);
+        report.count(&costs);
+        swarm.record(costs);
+        report.history.push(swarm.best_cost());
+        progress(generation, swarm.best_cost());
+    }
+    report.best = to_problem(&swarm.own_best[swarm.best]);
+    report.best_cost = swarm.best_cost();
+    report
+}
+
+impl SwarmReport {
+    /// Count a generation's evaluations and failures.
+    fn count(&mut self, costs: &[f64]) {
+        self.evaluations += costs.len();
+        self.failures += costs.iter().filter(|c| c.is_infinite()).count();
+    }
+}
+
+/// The particles in the unit cube: where they are, how they move, the cost where they are, and
+/// the best point each has seen.
+struct Swarm {
+    position: Vec<Vec<f64>>,
+    velocity: Vec<Vec<f64>>,
+    costs: Vec<f64>,
+    own_best: Vec<Vec<f64>>,
+    own_cost: Vec<f64>,
+    /// The particle with the lowest own cost.
+    best: usize,
+}
+
+impl Swarm {
+    /// Starting positions (random, the first ones at `seeds`, mapped into the cube) and
+    /// velocities (random, up to 0.1 per coordinate), in the random stream's order.
+    fn start(
+        bounds: &[(f64, f64)],
+        particles: usize,
+        seeds: &[Vec<f64>],
+        random: &mut Uniform,
+    ) -> (Vec<Vec<f64>>, Vec<Vec<f64>>) {
+        let dim = bounds.len();
+        let mut position: Vec<Vec<f64>> =
+            (0..particles).map(|_| (0..dim).map(|_| random.next()).collect()).collect();
+        for (p, seed) in position.iter_mut().zip(seeds) {
+            *p =
+                seed.iter().zip(bounds).map(|(x, (lo, hi))| ((x - lo) / (hi - lo)).clamp(0.0, 1.0)).collect();
+        }
+        let velocity: Vec<Vec<f64>> =
+            (0..particles).map(|_| (0..dim).map(|_| 0.2 * (random.next() - 0.5)).collect()).collect();
+        (position, velocity)
+    }
+
+    /// The swarm at its first evaluation.
+    fn new(position: Vec<Vec<f64>>, velocity: Vec<Vec<f64>>, costs: Vec<f64>) -> Self {
+        let (own_best, own_cost) = (position.clone(), costs.clone());
+        let best = best_of(&own_cost);
+        Self { position, velocity, costs, own_best, own_cost, best }
+    }
+
+    fn best_cost(&self) -> f64 {
+        self.own_cost[self.best]
+    }
+
+    /// One velocity update of every particle (inertia decaying linearly over the generations,
+    /// pulls towards its own and the swarm's best, repulsion), then the move, reflected at the
+    /// walls of the cube.
+    fn fly(&mut self, settings: &SwarmSettings, generation: usize, random: &mut Uniform) {
         let t = (generation - 1) as f64 / (settings.generations.max(2) - 1) as f64;
         let inertia = settings.inertia.0 + (settings.inertia.1 - settings.inertia.0) * t;
+        let dim = self.position.first().map_or(0, Vec::len);
         for p in 0..settings.particles {
             for k in 0..dim {
                 let (r1, r2) = (random.next(), random.next());
-                velocity[p][k] = inertia * velocity[p][k]
-                    + settings.cognitive * r1 * (own_best[p][k] - position[p][k])
-                    + settings.social * r2 * (own_best[best][k] - position[p][k]);
+                self.velocity[p][k] = inertia * self.velocity[p][k]
+                    + settings.cognitive * r1 * (self.own_best[p][k] - self.position[p][k])
+                    + settings.social * r2 * (self.own_best[self.best][k] - self.position[p][k]);
             }
-            repel(p, &mut velocity, &position, &costs, settings.repulsion_radius);
+            repel(p, &mut self.velocity, &self.position, &self.costs, settings.repulsion_radius);
             for k in 0..dim {
-                let x = position[p][k] + velocity[p][k];
+                let x = self.position[p][k] + self.velocity[p][k];
                 // Reflect at the walls of the cube.
-                position[p][k] = if x < 0.0 {
+                self.position[p][k] = if x < 0.0 {
                     -x
                 } else if x > 1.0 {
                     2.0 - x
@@ -149,21 +214,25 @@ where
                 .clamp(0.0, 1.0);
             }
         }
-        costs = evaluate(&position);
-        count(&mut report, &costs);
-        for p in 0..settings.particles {
-            if costs[p] < own_cost[p] {
-                own_cost[p] = costs[p];
-                own_best[p] = position[p].clone();
+    }
+
+    /// The costs at the new positions: each particle keeps its best point, and the swarm its
+    /// best particle.
+    fn record(&mut self, costs: Vec<f64>) {
+        self.costs = costs;
+        for p in 0..self.position.len() {
+            if self.costs[p] < self.own_cost[p] {
+                self.own_cost[p] = self.costs[p];
+                self.own_best[p] = self.position[p].clone();
             }
         }
-        best = best_of(&own_cost);
-        report.history.push(own_cost[best]);
-        progress(generation, own_cost[best]);
+        self.best = best_of(&self.own_cost);
     }
-    report.best = to_problem(&own_best[best]);
-    report.best_cost = own_cost[best];
-    report
+}
+
+/// The index of the lowest cost (the first of equals).
+fn best_of(own_cost: &[f64]) -> usize {
+    own_cost.iter().enumerate().fold(0, |b, (i, c)| if *c < own_cost[b] { i } else { b })
 }
 
 /// Push particle `p` away from every better particle closer than `radius`: a velocity away
@@ -206,5 +275,14 @@ mod tests {
         let report = minimize(cost, &[(-1.0, 1.0)], &SwarmSettings::default(), &[], &|_, _| {});
         assert!(report.failures > 0);
         assert!((report.best[0] - 0.5).abs() < 0.05, "{report:?}");
+    }
+
+    #[test]
+    fn shards_split_the_particles_and_offset_the_seed() {
+        let settings = SwarmSettings { particles: 64, seed: 5, ..SwarmSettings::default() };
+        let shard = settings.shard(3, 4);
+        assert_eq!((shard.particles, shard.seed), (16, 5 + 3 * 7919));
+        assert_eq!(SwarmSettings { particles: 3, ..settings }.shard(0, 4).particles, 1);
+        assert_eq!(SwarmSettings { seed: u64::MAX, ..settings }.shard(1, 2).seed, 7918);
     }
 }

@@ -4,11 +4,11 @@
 //!
 //! The test is run with the fabric's reference face up and face down, because a fabric that
 //! curls (a rest curvature `κ̄`, positive towards the reference face) droops differently on its
-//! two faces, and its clamped-clamped pear loop cannot show it ([`crate::pear_loop`]). Turning
+//! two faces, and its clamped-clamped pear loop cannot show it (the clamps fix both end tangents). Turning
 //! the strip over negates its rest curvature relative to gravity, which is how face down is
 //! simulated.
 //!
-//! The strip ([`crate::strip`]) starts flat and settles under its weight with the (6.1)
+//! The strip ([`super::strip`]) starts flat and settles under its weight with the (6.1)
 //! membrane and the (6.4) hinges; when the full weight gives no equilibrium from flat (a soft,
 //! long overhang), the weight is ramped up in steps.
 
@@ -19,8 +19,8 @@ use yarnhom_shell::statics::StaticError;
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
 use yarnhom_sparse::SpdSolver;
 
-use crate::measure::{Direction, Face};
-use crate::strip::{Clamps, Strip};
+use super::strip::{Clamps, Strip};
+use crate::data::set::{Direction, Face};
 
 /// A simulated cantilever reading.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]

@@ -1,8 +1,8 @@
 //! A fabric strip held in clamps and loaded by its weight: the common ground of the bending
-//! tests ([`crate::pear_loop`], [`crate::cantilever`]).
+//! tests (the pear loop, clamped at both ends, and the cantilever, clamped at one).
 //!
 //! The strip lies along `a` in its frame, its material coordinates rotated by the direction's
-//! angle (as in [`crate::swatch`]), so its hinges take the stiffness and rest curvature of the
+//! angle (as the swatch of the stretch tests), so its hinges take the stiffness and rest curvature of the
 //! direction it is cut along. A clamp holds two columns of vertices one edge apart, fixing the
 //! end's position and tangent; the free length is measured between the clamps' inner columns
 //! (arc length `0` at the first clamp, `length_m` at the second).
@@ -16,8 +16,8 @@ use yarnhom_shell::statics::{StaticError, StaticSettings, StaticStats, solve_sta
 use yarnhom_shell::{HingeBending, ShellMaterial, ShellMesh, StvkNeoHookean};
 use yarnhom_sparse::SpdSolver;
 
-use crate::measure::Direction;
-use crate::uniform::direction_angle;
+use super::uniform::direction_angle;
+use crate::data::set::Direction;
 
 /// Standard gravity (m/s²).
 pub const GRAVITY: f64 = 9.81;
@@ -25,6 +25,21 @@ pub const GRAVITY: f64 = 9.81;
 /// Width of the simulated strips (m): the readings are independent of it (within 0.5% of a 6 cm
 /// strip's), and a narrow strip is seven times cheaper.
 pub const STRIP_WIDTH_M: f64 = 0.01;
+
+/// The hinge bending of per-direction stiffnesses `k_j` (J) and rest curvatures
+/// `rest_curvature_per_m` (1/m), each given as one value for every direction or as three
+/// (weft, bias, warp); `None` for any other count.
+pub fn hinge_bending(k_j: &[f64], rest_curvature_per_m: &[f64]) -> Option<HingeBending> {
+    let [k_weft, k_bias, k_warp] = Direction::per_direction(k_j)?;
+    let [rest_curvature_weft, rest_curvature_bias, rest_curvature_warp] =
+        Direction::per_direction(rest_curvature_per_m)?;
+    Some(HingeBending {
+        rest_curvature_weft,
+        rest_curvature_bias,
+        rest_curvature_warp,
+        ..HingeBending::anisotropic(k_weft, k_bias, k_warp)
+    })
+}
 
 /// Which ends are clamped.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -147,5 +162,20 @@ impl Strip {
             .zip(&self.arc)
             .filter(|(_, (s, _))| (*s - self.length_m).abs() < 1e-9 * self.length_m)
             .map(|(p, _)| p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hinge_bending_takes_one_value_for_every_direction_or_three() {
+        assert_eq!(hinge_bending(&[2e-6], &[0.0]), Some(HingeBending::isotropic(2e-6)));
+        let b = hinge_bending(&[3e-6, 2e-6, 1e-6], &[10.0]).expect("three and one");
+        assert_eq!((b.k_weft, b.k_bias, b.k_warp), (3e-6, 2e-6, 1e-6));
+        assert_eq!((b.rest_curvature_weft, b.rest_curvature_bias, b.rest_curvature_warp), (10.0, 10.0, 10.0));
+        assert_eq!(hinge_bending(&[1e-6, 2e-6], &[0.0]), None);
+        assert_eq!(hinge_bending(&[1e-6], &[]), None);
     }
 }

@@ -1,18 +1,8 @@
-//! The bending fit (thesis Sec. 6.3.2): the hinge bending (6.4) that reproduces a fabric's
-//! measured bending tests, by simulation in the loop,
-//! `k_bending = argmin Σ_i (r(k_bending, d_i) - r_i)²`, with the pear loop
-//! ([`crate::pear_loop`]) and, beyond the thesis, the cantilever ([`crate::cantilever`]) on
-//! both faces, which shows a rest curvature the pear loop cannot.
+//! A measurement set's bending tests, simulated together: the pear loops ([`super::pear_loop`])
+//! and cantilevers ([`super::cantilever`], both faces) of its `bending.csv` and `cantilever.csv`,
+//! their readings, and the normalized errors of simulated readings that the bending fit
+//! minimizes and the diagnosis scores. Synthetic sets simulate their bending tests through it too.
 //!
-//! Models ([`BendingModel`]), each nested in the next by its parameters:
-//! * `Isotropic`: one stiffness `k_θ`, flat at rest (the diagnosis' base: straight bending);
-//! * `Anisotropic`: `k_θ` per tested direction, interpolated by the edge direction (the
-//!   thesis' `{k_weft, k_bias, k_warp}`); an untested direction takes the geometric mean of
-//!   the tested ones;
-//! * `RestCurvature`: one `k_θ` and a rest curvature `κ̄` per direction with cantilever tests.
-//!
-//! Stiffnesses are fitted in `log10 k` (from the best of a coarse scan for the isotropic
-//! model), rest curvatures in units of 10 /m, by Levenberg-Marquardt ([`crate::lm`]).
 //! Residuals are each reading's error over the mean measured value of its test and direction
 //! (the percentage error of Fig. 6.13); pear loops and cantilevers of one direction count
 //! separately.
@@ -25,20 +15,19 @@
 use rayon::prelude::*;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
+use yarnhom_geom::stats::root_mean_square;
 use yarnhom_shell::{HingeBending, StvkNeoHookean};
 
-use crate::cantilever::CantileverTest;
-use crate::lm::{LmSettings, minimize};
-use crate::measure::{Direction, Face, MeasurementSet};
-use crate::pear_loop::PearLoopTest;
-use crate::shell_fit::rms;
+use super::cantilever::CantileverTest;
+use super::pear_loop::PearLoopTest;
+use crate::data::set::{Direction, Face, MeasurementSet};
 
 /// Edge length of every simulated bending strip (m).
 pub const BENDING_SPACING_M: f64 = 0.005;
 
-/// Why a bending fit cannot run.
+/// Why a set's bending tests cannot be simulated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum BendingFitError {
+pub enum BendingTestsError {
     /// The set has no bending tests.
     #[error("the measurement set has no bending tests (bending.csv, cantilever.csv)")]
     NoTests,
@@ -48,21 +37,6 @@ pub enum BendingFitError {
         "the bending tests measure stiffness against weight: fabric.toml needs `swatch.areal_density_kg_m2`"
     )]
     NoDensity,
-    /// No simulation of the starting model reached equilibrium.
-    #[error("no starting bending stiffness gives every bending test an equilibrium")]
-    NoStart,
-}
-
-/// Which bending parameters are fitted.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
-#[serde(rename_all = "kebab-case")]
-pub enum BendingModel {
-    /// One stiffness, flat at rest.
-    Isotropic,
-    /// A stiffness per tested direction, flat at rest.
-    Anisotropic,
-    /// One stiffness and a rest curvature per direction with cantilever tests.
-    RestCurvature,
 }
 
 /// One bending test to simulate.
@@ -119,11 +93,12 @@ pub struct BendingTests {
 impl BendingTests {
     /// The bending tests of `set`; within each test kind, direction and face the `k`-th reading
     /// by abscissa is fitted when `fit(k)`.
-    pub fn of_set(set: &MeasurementSet, fit: impl Fn(usize) -> bool) -> Result<Self, BendingFitError> {
+    pub fn of_set(set: &MeasurementSet, fit: impl Fn(usize) -> bool) -> Result<Self, BendingTestsError> {
         if set.bending.is_empty() && set.cantilever.is_empty() {
-            return Err(BendingFitError::NoTests);
+            return Err(BendingTestsError::NoTests);
         }
-        let areal_density_kg_m2 = set.fabric.swatch.areal_density_kg_m2.ok_or(BendingFitError::NoDensity)?;
+        let areal_density_kg_m2 =
+            set.fabric.swatch.areal_density_kg_m2.ok_or(BendingTestsError::NoDensity)?;
         let mut tests = Vec::new();
         let mut measured = Vec::new();
         for p in &set.bending {
@@ -152,7 +127,7 @@ impl BendingTests {
     }
 
     /// The directions with tests, and those with cantilever tests, in [`Direction::ALL`] order.
-    fn directions(&self, cantilever_only: bool) -> Vec<Direction> {
+    pub(crate) fn directions(&self, cantilever_only: bool) -> Vec<Direction> {
         Direction::ALL
             .into_iter()
             .filter(|d| {
@@ -286,7 +261,7 @@ impl BendingTests {
                         })
                         .map(|i| (simulated[i] - self.measured[i]) / self.scale[i])
                         .collect();
-                    (!r.is_empty()).then(|| rms(&r))
+                    (!r.is_empty()).then(|| root_mean_square(r.iter().copied()))
                 };
                 BendingDirectionError { direction, pear_loop: error(false), cantilever: error(true) }
             })
@@ -328,145 +303,4 @@ pub struct BendingDirectionError {
     pub pear_loop: Option<f64>,
     /// Cantilever tip-drop error (absent without cantilever tests).
     pub cantilever: Option<f64>,
-}
-
-/// The free parameters of a model on a set of tests.
-struct Parameterization {
-    model: BendingModel,
-    stiff: Vec<Direction>,
-    curled: Vec<Direction>,
-}
-
-/// Units of the fitted rest curvatures (1/m).
-const CURVATURE_UNIT: f64 = 10.0;
-
-impl Parameterization {
-    fn new(model: BendingModel, tests: &BendingTests) -> Self {
-        let stiff = match model {
-            BendingModel::Anisotropic => tests.directions(false),
-            _ => Vec::new(),
-        };
-        let curled = match model {
-            BendingModel::RestCurvature => tests.directions(true),
-            _ => Vec::new(),
-        };
-        Self { model, stiff, curled }
-    }
-
-    fn decode(&self, p: &[f64]) -> HingeBending {
-        let mut k = [0.0; 3];
-        match self.model {
-            BendingModel::Anisotropic => {
-                let tested: Vec<f64> = p[..self.stiff.len()].to_vec();
-                let mean = tested.iter().sum::<f64>() / tested.len() as f64;
-                for (i, d) in Direction::ALL.iter().enumerate() {
-                    k[i] = 10f64.powf(self.stiff.iter().position(|s| s == d).map_or(mean, |j| tested[j]));
-                }
-            }
-            _ => k = [10f64.powf(p[0]); 3],
-        }
-        let mut rest = [0.0; 3];
-        for (j, d) in self.curled.iter().enumerate() {
-            rest[Direction::ALL.iter().position(|a| a == d).expect("a direction")] =
-                CURVATURE_UNIT * p[1 + j];
-        }
-        HingeBending {
-            k_weft: k[0],
-            k_bias: k[1],
-            k_warp: k[2],
-            rest_curvature_weft: rest[0],
-            rest_curvature_bias: rest[1],
-            rest_curvature_warp: rest[2],
-        }
-    }
-
-    fn encode(&self, b: &HingeBending) -> Vec<f64> {
-        let k = [b.k_weft, b.k_bias, b.k_warp];
-        let rest = [b.rest_curvature_weft, b.rest_curvature_bias, b.rest_curvature_warp];
-        let index = |d: &Direction| Direction::ALL.iter().position(|a| a == d).expect("a direction");
-        match self.model {
-            BendingModel::Anisotropic => self.stiff.iter().map(|d| k[index(d)].log10()).collect(),
-            _ => {
-                let mean = k.iter().map(|k| k.log10()).sum::<f64>() / 3.0;
-                std::iter::once(mean)
-                    .chain(self.curled.iter().map(|d| rest[index(d)] / CURVATURE_UNIT))
-                    .collect()
-            }
-        }
-    }
-}
-
-/// A fitted bending model.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct BendingFit {
-    /// The model fitted.
-    pub model: BendingModel,
-    /// The fitted hinge bending.
-    pub bending: HingeBending,
-    /// Parameters fitted.
-    pub parameter_count: usize,
-    /// RMS normalized error on the fitted readings.
-    pub error: f64,
-    /// RMS normalized error on the held-out readings (absent when every reading is fitted).
-    pub heldout_error: Option<f64>,
-    /// Errors per direction over every reading.
-    pub by_direction: Vec<BendingDirectionError>,
-    /// The simulated reading of every test, in test order.
-    pub simulated: Vec<f64>,
-    /// Levenberg-Marquardt iterations.
-    pub iterations: usize,
-    /// Simulations of the whole test set.
-    pub evaluations: usize,
-}
-
-/// Fit `model` to the fitted readings of `tests`, with `membrane`, from `start` (the isotropic
-/// model may start from a scan instead: `None`).
-pub fn fit_bending(
-    tests: &BendingTests,
-    membrane: &StvkNeoHookean,
-    model: BendingModel,
-    start: Option<&HingeBending>,
-    lm: &LmSettings,
-) -> Result<BendingFit, BendingFitError> {
-    let parameterization = Parameterization::new(model, tests);
-    let cost = |p: &[f64]| -> Option<Vec<f64>> {
-        let simulated = tests.simulate(membrane, &parameterization.decode(p))?;
-        Some(tests.residuals(&simulated, true))
-    };
-    let (from, scan_evaluations) = match start {
-        Some(b) => (parameterization.encode(b), 0),
-        None => scan_start(&parameterization, &cost)?,
-    };
-    let report = minimize(cost, &from, lm).ok_or(BendingFitError::NoStart)?;
-    let bending = parameterization.decode(&report.params);
-    let simulated = tests.simulate(membrane, &bending).ok_or(BendingFitError::NoStart)?;
-    let heldout = tests.residuals(&simulated, false);
-    Ok(BendingFit {
-        model,
-        bending,
-        parameter_count: report.params.len(),
-        error: rms(&tests.residuals(&simulated, true)),
-        heldout_error: (!heldout.is_empty()).then(|| rms(&heldout)),
-        by_direction: tests.errors_by_direction(&simulated),
-        simulated,
-        iterations: report.iterations,
-        evaluations: report.evaluations + scan_evaluations + 1,
-    })
-}
-
-/// The best isotropic, flat stiffness of a scan over `10^-8 .. 10^-3` J (half decades); also
-/// the evaluations made.
-fn scan_start(
-    parameterization: &Parameterization,
-    cost: &(impl Fn(&[f64]) -> Option<Vec<f64>> + Sync),
-) -> Result<(Vec<f64>, usize), BendingFitError> {
-    let candidates: Vec<Vec<f64>> = (0..=10)
-        .map(|i| parameterization.encode(&HingeBending::isotropic(10f64.powf(-8.0 + 0.5 * i as f64))))
-        .collect();
-    let best = candidates
-        .iter()
-        .filter_map(|p| cost(p).map(|r| (r.iter().map(|x| x * x).sum::<f64>(), p)))
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .ok_or(BendingFitError::NoStart)?;
-    Ok((best.1.clone(), candidates.len()))
 }
