@@ -22,7 +22,9 @@ use crate::container::{self, content_hash};
 use crate::error::{Error, Result};
 use crate::membrane::MembraneMaterial;
 use crate::report::report_format;
-use crate::{AnyArtifact, Artifact, Fabric, Header, InputRef, JsonDocument, Provenance, Spline, YarnModel};
+use crate::{
+    AnyArtifact, Artifact, Fabric, Header, InputRef, JsonDocument, Pattern, Provenance, Spline, YarnModel,
+};
 
 /// The first bytes of an HDF5 file.
 const HDF5_MAGIC: &[u8] = b"\x89HDF\r\n\x1a\n";
@@ -181,6 +183,14 @@ pub fn open_yarn_model(spec: &str) -> Result<(YarnModel, Option<InputRef>)> {
         Some(_) => Ok((builtin_yarn_model(spec)?, None)),
         None => open_artifact::<YarnModel>(spec).map(|o| (o.value, Some(o.input))),
     }
+}
+
+/// The pattern at `path` and the yarn model of `model_spec` (see [`open_yarn_model`]) a tile
+/// is built from, and the inputs they name in provenance (the pattern first).
+pub fn open_pattern_and_model(path: &Path, model_spec: &str) -> Result<(Pattern, YarnModel, Vec<InputRef>)> {
+    let pattern = open_artifact::<Pattern>(path)?;
+    let (model, model_input) = open_yarn_model(model_spec)?;
+    Ok((pattern.value, model, std::iter::once(pattern.input).chain(model_input).collect()))
 }
 
 /// A built-in yarn model: `table4.1:ROW` (or just `ROW`), a row of the thesis' Table 4.1.

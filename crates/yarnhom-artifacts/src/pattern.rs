@@ -18,6 +18,7 @@ use crate::error::ValidationError;
 /// Knitted or woven: decides, e.g., the tension applied by the rest-state heuristic (Alg. 2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, schemars::JsonSchema)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Fabric {
     /// Weft- or warp-knitted: yarns form interlocked loops.
     Knit,

@@ -3,12 +3,13 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use clap::{Args, Subcommand, ValueEnum};
+use clap::{Args, Subcommand};
 use yarnhom_artifacts::report::{Report, read_report, write_report};
 use yarnhom_calib::cause::CauseId;
 use yarnhom_calib::data::set::{Direction, MeasurementSet, Phase};
 use yarnhom_calib::data::targets::TargetPlan;
-use yarnhom_calib::diagnosis::{confirm, diagnose, settings};
+use yarnhom_calib::diagnosis::settings::Budget;
+use yarnhom_calib::diagnosis::{confirm, diagnose};
 use yarnhom_calib::experiments::pear_loop::PearLoopTest;
 use yarnhom_calib::experiments::strip::hinge_bending;
 use yarnhom_calib::experiments::synth::{HiddenEffect, SynthRequest, ground_truth};
@@ -20,8 +21,8 @@ use yarnhom_figures::{Figure, render_svg};
 
 use crate::Outcome;
 use crate::args::{finite, max_stretch, non_negative, positive};
-use crate::calibrate_yarn::{create_dir, print_progress, set_pattern};
-use crate::output::write_bytes;
+use crate::calibrate_yarn::{print_progress, set_pattern};
+use crate::output::{create_dir, write_bytes};
 
 #[derive(Debug, Subcommand)]
 pub enum CalibrateCommand {
@@ -83,28 +84,6 @@ fn parse_direction(name: &str) -> Result<Direction, String> {
     Direction::parse(name).ok_or_else(|| format!("unknown direction '{name}' (weft, bias, warp)"))
 }
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum Budget {
-    /// Coarse swatches (8 mm), 10 optimizer iterations per model; no yarn-level confirmation.
-    Quick,
-    /// 5 mm swatches, 30 iterations per model; the cause confirmed on the tile by a reduced
-    /// yarn-level fit (swarm 16 x 3 on 5 targets per direction, Gauss-Newton 8 Jacobians on 8).
-    Normal,
-    /// 3.5 mm swatches, 80 iterations per model; the confirmation by the full yarn-level fit
-    /// (swarm 64 x 10 on 7 targets, Gauss-Newton 20 Jacobians on 20).
-    Thorough,
-}
-
-impl From<Budget> for settings::Budget {
-    fn from(budget: Budget) -> Self {
-        match budget {
-            Budget::Quick => settings::Budget::Quick,
-            Budget::Normal => settings::Budget::Normal,
-            Budget::Thorough => settings::Budget::Thorough,
-        }
-    }
-}
-
 #[derive(Debug, Args)]
 pub struct DiagnoseArgs {
     /// The measurement set directory.
@@ -128,34 +107,6 @@ pub struct DiagnoseArgs {
     pub yarn_stiffness: Option<f64>,
 }
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum EffectArg {
-    None,
-    AreaPreservation,
-    BiphasicStretch,
-    TwoPhaseContact,
-    FrictionHysteresis,
-    RestCurvature,
-    AnisotropicBending,
-    /// Off the catalog (softening past an onset): the diagnosis should say `unexplained`.
-    Softening,
-}
-
-impl From<EffectArg> for HiddenEffect {
-    fn from(effect: EffectArg) -> Self {
-        match effect {
-            EffectArg::None => HiddenEffect::None,
-            EffectArg::AreaPreservation => HiddenEffect::AreaPreservation,
-            EffectArg::BiphasicStretch => HiddenEffect::BiphasicStretch,
-            EffectArg::TwoPhaseContact => HiddenEffect::TwoPhaseContact,
-            EffectArg::FrictionHysteresis => HiddenEffect::FrictionHysteresis,
-            EffectArg::RestCurvature => HiddenEffect::RestCurvature,
-            EffectArg::AnisotropicBending => HiddenEffect::AnisotropicBending,
-            EffectArg::Softening => HiddenEffect::Softening,
-        }
-    }
-}
-
 #[derive(Debug, Args)]
 pub struct SynthArgs {
     /// Output directory of the measurement set (created).
@@ -163,7 +114,7 @@ pub struct SynthArgs {
     pub output: PathBuf,
     /// The effect hidden in the data.
     #[arg(long, value_enum)]
-    pub effect: EffectArg,
+    pub effect: HiddenEffect,
     /// Strength of the effect (1: clearly visible at 2% noise).
     #[arg(long, default_value_t = 1.0, value_parser = non_negative)]
     pub strength: f64,
@@ -187,26 +138,6 @@ pub struct SynthArgs {
     pub truth: Option<PathBuf>,
 }
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum ModelArg {
-    /// Plain anisotropic StVK.
-    Stvk,
-    /// StVK with the Neo-Hookean area terms (6.1).
-    StvkNeoHookean,
-    /// (6.1) with jamming past an onset compression (the `two-phase-contact` extension).
-    StvkNeoHookeanJamming,
-}
-
-impl From<ModelArg> for MembraneModel {
-    fn from(model: ModelArg) -> Self {
-        match model {
-            ModelArg::Stvk => MembraneModel::Stvk,
-            ModelArg::StvkNeoHookean => MembraneModel::StvkNeoHookean,
-            ModelArg::StvkNeoHookeanJamming => MembraneModel::StvkNeoHookeanJamming,
-        }
-    }
-}
-
 #[derive(Debug, Args)]
 pub struct ShellArgs {
     /// The measurement set directory.
@@ -225,7 +156,7 @@ pub struct ShellArgs {
     pub spacing: f64,
     /// The membrane model.
     #[arg(long, value_enum, default_value = "stvk-neo-hookean")]
-    pub model: ModelArg,
+    pub model: MembraneModel,
 }
 
 pub fn run(cmd: CalibrateCommand) -> Result<Outcome> {
@@ -246,7 +177,7 @@ fn shell(args: ShellArgs) -> Result<Outcome> {
             force_cap_n: args.force_cap,
             phase: Phase::Load,
         },
-        model: args.model.into(),
+        model: args.model,
         spacing_m: args.spacing,
         ..ShellFitSettings::default()
     };
@@ -280,7 +211,7 @@ fn write_figure(path: &Path, figure: &Figure) -> Result<()> {
 
 fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
     let set = MeasurementSet::read(&args.set)?;
-    let budget = settings::Budget::from(args.budget);
+    let budget = args.budget;
     let settings = budget.settings(args.targets as usize, args.force_cap);
     let (name, readings) = (&set.fabric.name, set.stretch.len());
     eprintln!(
@@ -316,7 +247,7 @@ fn diagnose_command(args: DiagnoseArgs) -> Result<Outcome> {
 fn synth(args: SynthArgs) -> Result<Outcome> {
     let request = SynthRequest {
         name: args.output.file_name().and_then(|n| n.to_str()).unwrap_or("synthetic").to_string(),
-        effect: args.effect.into(),
+        effect: args.effect,
         strength: args.strength,
         noise: args.noise,
         seed: args.seed,

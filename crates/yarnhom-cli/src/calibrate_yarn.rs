@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
-use clap::{Args, ValueEnum};
+use anyhow::Result;
+use clap::Args;
 use yarnhom_artifacts::open::open_artifact;
 use yarnhom_artifacts::report::{Report, read_report, write_report};
 use yarnhom_artifacts::{Pattern, Provenance, container};
@@ -20,20 +20,7 @@ use yarnhom_figures::render_svg;
 
 use crate::Outcome;
 use crate::args::positive;
-use crate::output::write_bytes;
-
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub enum LocalArg {
-    /// COBYLA (derivative-free), as the thesis.
-    Cobyla,
-    /// Levenberg-Marquardt on the residuals of (6.11), forward-difference Jacobian.
-    Lm,
-    /// Gauss-Newton / Levenberg-Marquardt with the Jacobian from the parameter sensitivities of
-    /// the tile's equilibrium (one evaluation per Jacobian instead of one per parameter).
-    GaussNewton,
-    /// No local step.
-    None,
-}
+use crate::output::{create_dir, write_bytes};
 
 #[derive(Debug, Args)]
 pub struct YarnArgs {
@@ -61,7 +48,7 @@ pub struct YarnArgs {
     pub local_targets: u32,
     /// The local optimizer.
     #[arg(long, value_enum, default_value = "cobyla")]
-    pub local: LocalArg,
+    pub local: LocalSolver,
     /// Evaluations of the local step at most (COBYLA) or Jacobians (LM, Gauss-Newton).
     #[arg(long, default_value_t = 60)]
     pub budget: u32,
@@ -109,12 +96,7 @@ impl YarnArgs {
             swarm: self.shard.map_or(swarm, |(k, n)| swarm.shard(k, n)),
             swarm_targets: self.swarm_targets as usize,
             local_targets: self.local_targets as usize,
-            local: match (self.shard, self.local) {
-                (Some(_), _) | (None, LocalArg::None) => LocalSolver::None,
-                (None, LocalArg::Cobyla) => LocalSolver::Cobyla,
-                (None, LocalArg::Lm) => LocalSolver::LevenbergMarquardt,
-                (None, LocalArg::GaussNewton) => LocalSolver::GaussNewton,
-            },
+            local: if self.shard.is_some() { LocalSolver::None } else { self.local },
             local_budget: self.budget as usize,
             rest: RestShapeSettings { max_length_change: 0.2, max_resets: self.max_resets as usize },
             ..YarnFitSettings::default()
@@ -167,11 +149,6 @@ pub(crate) fn print_progress(event: YarnFitEvent) {
         YarnFitEvent::Generation(g, best) => eprintln!("  swarm generation {g}: best g = {best:.5}"),
         YarnFitEvent::LocalEvaluation(n, cost) => eprintln!("  local evaluation {n}: g = {cost:.5}"),
     }
-}
-
-/// Create the output directory.
-pub(crate) fn create_dir(dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
 }
 
 /// The input geometry of the set in `set_dir`: its pattern file, read like any input, or its

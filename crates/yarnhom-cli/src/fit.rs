@@ -6,17 +6,16 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::arcsim::ArcsimMaterial;
-use yarnhom_artifacts::grid::AXIS_NAMES;
 use yarnhom_artifacts::open::{Format, Opened, open, open_artifact};
 use yarnhom_artifacts::{AnyArtifact, AxisLimit, FitSettings, Grid, Spline};
 use yarnhom_fit::fit::restrict_grid;
 use yarnhom_fit::ranges::STOCKINETTE_SPAN_2D_BENDING;
 use yarnhom_fit::report::fit_report;
-use yarnhom_fit::{compare_1d_terms, fit_grid_with_regularized_terms};
+use yarnhom_fit::{comparison_report, fit_grid_with_regularized_terms};
 
 use crate::Outcome;
 use crate::args::{parse_axis, parse_interval};
-use crate::output::{write_artifact, write_bytes, wrote};
+use crate::output::{create_dir, write_artifact, write_bytes, wrote};
 
 /// `yarnhom fit GRID -o X.spline.yh`, or one of the subcommands.
 #[derive(Debug, Args)]
@@ -209,8 +208,7 @@ fn export(args: ExportArgs) -> anyhow::Result<Outcome> {
 fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
     let grid = open_artifact::<Grid>(&args.grid)?.value;
     let spline = open_artifact::<Spline>(&args.spline)?.value;
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("cannot create {}", args.output.display()))?;
+    create_dir(&args.output)?;
     for (file, figure) in yarnhom_fit::figures::fit_figures(&grid, &spline) {
         let path = args.output.join(file);
         write_bytes(&path, yarnhom_figures::render_svg(&figure)?.as_bytes())?;
@@ -223,22 +221,6 @@ fn plot(args: PlotArgs) -> anyhow::Result<Outcome> {
 fn compare(args: CompareArgs) -> anyhow::Result<Outcome> {
     let a = open_artifact::<Spline>(&args.first)?.value;
     let b = open_artifact::<Spline>(&args.second)?.value;
-    println!(
-        "1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:",
-        a.name, b.name
-    );
-    println!("  term  range                 RMS first  RMS second  RMS difference  shape correlation");
-    for c in compare_1d_terms(&a, &b) {
-        println!(
-            "  {:4}  [{:8.3}, {:8.3}]  {:10.4e} {:11.4e} {:15.4e} {:18.3}",
-            AXIS_NAMES[c.axis],
-            c.range[0],
-            c.range[1],
-            c.rms[0],
-            c.rms[1],
-            c.rms_difference,
-            c.shape_correlation
-        );
-    }
+    println!("{}", comparison_report(&a, &b));
     Ok(Outcome::Success)
 }

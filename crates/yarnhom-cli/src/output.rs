@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::Context;
+use indicatif::{ProgressBar, ProgressStyle};
 use yarnhom_artifacts::{Artifact, Provenance, container, write_atomic};
 use yarnhom_trace::{TraceMetadata, TraceSink, is_stdio};
 
@@ -35,6 +36,11 @@ pub fn write_artifact<T: Artifact>(
     Ok(())
 }
 
+/// Creates a directory (and its parents) to write into.
+pub fn create_dir(dir: &Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))
+}
+
 /// Says on stderr that `path` was written.
 pub fn wrote(path: &Path) {
     eprintln!("wrote {}", path.display());
@@ -62,4 +68,13 @@ pub fn print_summary(text: &str, trace: Option<&str>) {
     } else {
         println!("{text}");
     }
+}
+
+/// A progress bar over `total` of `unit` (`samples`, `frames`), with the elapsed time, the
+/// expected time left and the caller's message.
+pub fn progress_bar(total: u64, unit: &str) -> ProgressBar {
+    let template = format!("{{bar:40}} {{pos}}/{{len}} {unit}, {{elapsed}} elapsed, ETA {{eta}} {{msg}}");
+    let bar = ProgressBar::new(total);
+    bar.set_style(ProgressStyle::with_template(&template).unwrap_or_else(|_| ProgressStyle::default_bar()));
+    bar
 }

@@ -43,19 +43,10 @@ pub struct MirrorArgs {
     pub input: PathBuf,
     /// The coordinate the mirror negates.
     #[arg(long, value_enum, default_value = "x1")]
-    pub axis: AxisArg,
+    pub axis: MirrorAxis,
     /// Write the mirror image here.
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-}
-
-/// Mirror axes on the command line.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum AxisArg {
-    /// `X1 -> -X1` (a knit's wale axis).
-    X1,
-    /// `X2 -> -X2`.
-    X2,
 }
 
 #[derive(Debug, Args)]
@@ -85,7 +76,7 @@ pub struct ImportArgs {
     pub input: PathBuf,
     /// Knit or woven; inferred from the geometry when not given (knitted yarns loop back).
     #[arg(long, value_enum)]
-    pub fabric: Option<FabricArg>,
+    pub fabric: Option<Fabric>,
     /// Pattern name (default: the file name without extension).
     #[arg(long)]
     pub name: Option<String>,
@@ -101,24 +92,6 @@ pub struct ExportArgs {
     /// Output `.pyp` file (default: NAME.pyp; `-` for standard output).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-}
-
-/// Fabric kinds on the command line.
-#[derive(Debug, Clone, Copy, clap::ValueEnum)]
-pub enum FabricArg {
-    /// Knitted.
-    Knit,
-    /// Woven.
-    Woven,
-}
-
-impl From<FabricArg> for Fabric {
-    fn from(f: FabricArg) -> Self {
-        match f {
-            FabricArg::Knit => Fabric::Knit,
-            FabricArg::Woven => Fabric::Woven,
-        }
-    }
 }
 
 pub fn run(cmd: PatternCommand) -> anyhow::Result<Outcome> {
@@ -152,7 +125,7 @@ fn generate(args: GenerateArgs) -> anyhow::Result<()> {
 }
 
 fn import(args: ImportArgs) -> anyhow::Result<()> {
-    let input = open_pattern_as(&args.input, args.fabric.map(Fabric::from))?;
+    let input = open_pattern_as(&args.input, args.fabric)?;
     anyhow::ensure!(input.format == Format::Pyp, "{}: not a .pyp file", args.input.display());
     let (header, artifact) = input.into_artifact()?;
     let AnyArtifact::Pattern(mut pattern) = artifact else {
@@ -175,11 +148,7 @@ fn export(args: ExportArgs) -> anyhow::Result<()> {
 fn mirror(args: MirrorArgs) -> anyhow::Result<()> {
     let opened = open_artifact::<Pattern>(&args.input)?;
     let pattern = &opened.value;
-    let axis = match args.axis {
-        AxisArg::X1 => MirrorAxis::X1,
-        AxisArg::X2 => MirrorAxis::X2,
-    };
-    let mirror = find_mirror(pattern, axis)?;
+    let mirror = find_mirror(pattern, args.axis)?;
     println!("{}", mirror.report(pattern));
     if let Some(output) = args.output {
         let image = mirrored(pattern, &mirror)?;

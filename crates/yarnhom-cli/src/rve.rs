@@ -1,15 +1,14 @@
 //! `yarnhom rve ...`: the periodic yarn tile (thesis Ch. 3).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_artifacts::open::{base_name, open_artifact, open_yarn_model};
-use yarnhom_artifacts::{InputRef, Pattern, YarnModel};
+use yarnhom_artifacts::open::{base_name, open_pattern_and_model};
 use yarnhom_geom::MacroStrain;
 use yarnhom_rve::homogenize::{Outputs, solve_to_artifact};
-use yarnhom_rve::messages::{iteration_message, yarn_frame};
+use yarnhom_rve::messages::record_iterate;
 use yarnhom_rve::relax::RelaxEvent;
 use yarnhom_rve::{Iterate, RelaxMethod, RelaxOptions, RveModel, SolveOptions, StepControl};
 use yarnhom_trace::TraceMetadata;
@@ -136,16 +135,6 @@ pub fn run(cmd: RveCommand) -> anyhow::Result<Outcome> {
     }
 }
 
-/// The pattern and yarn model a tile command works on, and the inputs they name in provenance.
-pub(crate) fn open_pattern_and_model(
-    path: &Path,
-    model_spec: &str,
-) -> anyhow::Result<(Pattern, YarnModel, Vec<InputRef>)> {
-    let pattern = open_artifact::<Pattern>(path)?;
-    let (model, model_input) = open_yarn_model(model_spec)?;
-    Ok((pattern.value, model, std::iter::once(pattern.input).chain(model_input).collect()))
-}
-
 /// `--ccd D` as a step control, or the step limit of A.2.3.
 fn step_control(ccd: Option<f64>) -> anyhow::Result<StepControl> {
     match ccd {
@@ -182,12 +171,7 @@ fn solve(args: SolveArgs) -> anyhow::Result<Outcome> {
     let mut trace_error = None;
     let mut record = |iterate: &Iterate<'_>| {
         if let Some(sink) = trace.as_mut().filter(|_| trace_error.is_none()) {
-            let frame = iterate.iteration as u64;
-            let written = sink
-                .write(&iteration_message(iterate))
-                .and_then(|()| sink.write(&yarn_frame(&pattern, &tile, &placement, iterate.state, frame)))
-                .and_then(|()| sink.end_frame());
-            trace_error = written.err();
+            trace_error = record_iterate(sink, &pattern, &tile, &placement, iterate).err();
         }
     };
     let outputs = Outputs { stress: !args.no_stress, fd_stress: args.fd_stress };
@@ -237,7 +221,7 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
     };
     eprintln!("relaxing '{}' ({} vertices) with '{}'", pattern.name, pattern.vertex_count(), model.name);
     let started = Instant::now();
-    let mut show = |event: RelaxEvent| show_relax_event(event, started.elapsed().as_secs_f64());
+    let mut show = |event: RelaxEvent| eprintln!("  {event} ({:.1} s)", started.elapsed().as_secs_f64());
     let (relaxed, report) = yarnhom_rve::relax(&pattern, &model, &options, &mut show)
         .with_context(|| format!("{}", args.pattern.display()))?;
     if !args.keep_rest_shape && report.stress_free_energy_j >= options.stress_free_energy_j {
@@ -249,33 +233,9 @@ fn relax(args: RelaxArgs) -> anyhow::Result<Outcome> {
     let output =
         args.output.unwrap_or_else(|| format!("{}.relaxed.pattern.yh", base_name(&args.pattern)).into());
     write_artifact(&output, &relaxed, "rve relax", inputs)?;
-    let [sx, sa, sy] = report.residual_stress_j_m2;
-    println!(
-        "relaxed '{}': {} resets, periods {:.4} x {:.4} mm (period strain {:+.4}, {:+.4}), {} Newton iterations, {:.1} s\n  in-plane stress at zero strain: dsx {sx:.3e}, dsa {sa:.3e}, dsy {sy:.3e} J/m²",
-        relaxed.name,
-        report.resets,
-        relaxed.period_m[0] * 1e3,
-        relaxed.period_m[1] * 1e3,
-        report.period_strain[0],
-        report.period_strain[1],
-        report.iterations,
-        started.elapsed().as_secs_f64()
-    );
+    println!("{}", report.summary(&relaxed, started.elapsed().as_secs_f64()));
     wrote(&output);
     Ok(Outcome::Success)
-}
-
-/// A stage of a relaxation, on stderr.
-fn show_relax_event(event: RelaxEvent, seconds: f64) {
-    match event {
-        RelaxEvent::Reset(k, energy) => {
-            eprintln!("  reset {:>3}: relaxed tile energy {energy:.3e} J ({seconds:.1} s)", k + 1)
-        }
-        RelaxEvent::PeriodStep(s, sigma) => eprintln!(
-            "  periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m² ({seconds:.1} s)",
-            s[0], s[1], sigma[0], sigma[1]
-        ),
-    }
 }
 
 /// Algorithm 2, or the Sec. 6.5.2 estimation with `--estimation BOUND`.

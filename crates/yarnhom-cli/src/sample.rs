@@ -3,29 +3,23 @@
 //! and shards (`--shard K/N`) that `yarnhom grid merge` joins bit-identically.
 
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressStyle};
-use yarnhom_artifacts::grid::{AXIS_NAMES, Grid, GridSample, GridShard};
-use yarnhom_artifacts::open::{base_name, open_artifact};
-use yarnhom_artifacts::{Pattern, Spline};
+use yarnhom_artifacts::Spline;
+use yarnhom_artifacts::grid::{AXIS_NAMES, GridShard};
+use yarnhom_artifacts::open::{base_name, open_artifact, open_pattern_and_model};
 use yarnhom_fit::sampled_ranges;
 use yarnhom_rve::RveModel;
-use yarnhom_rve::checkpoint::{Checkpoint, CheckpointLine, RunKey};
-use yarnhom_rve::messages::{sample_message, yarns_in_order};
-use yarnhom_rve::sample::{
-    LineResult, PlanRanges, PlaneRange, SampleOptions, SampleOutcome, SamplePlan, SweepLine, sample_lines,
-    shard_lines,
-};
-use yarnhom_trace::{TraceError, TraceMetadata, TraceSink};
+use yarnhom_rve::checkpoint::RunKey;
+use yarnhom_rve::sample::{PlanRanges, PlaneRange, SampleOptions, SamplePlan};
+use yarnhom_rve::sweep::{Sweep, Swept};
+use yarnhom_trace::TraceMetadata;
 
 use crate::Outcome;
 use crate::args::{parse_axis, parse_interval};
-use crate::output::{finish_trace, open_trace, print_summary, write_artifact, wrote};
-use crate::rve::open_pattern_and_model;
+use crate::output::{finish_trace, open_trace, print_summary, progress_bar, write_artifact, wrote};
 
 #[derive(Debug, Args)]
 pub struct SampleArgs {
@@ -132,32 +126,26 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
         stress: !args.no_stress,
         geometry: args.geometry,
     };
+    let sizes = [args.n1d, args.n2d];
     let key = RunKey::new(
         &inputs[0].content_hash,
         &model.name,
         &plan,
-        [args.n1d, args.n2d],
+        sizes,
         shard.map(|s| (s.index, s.count)),
         &options,
     );
     let output =
         args.output.clone().unwrap_or_else(|| format!("{}.grid.yh", base_name(&args.pattern)).into());
     let checkpoint_path = PathBuf::from(format!("{}.checkpoint", output.display()));
-    let (checkpoint, done) = Checkpoint::resume(&checkpoint_path, &key)?;
-    let mine = match shard {
-        Some(s) => shard_lines(&plan.lines(), s.index as usize, s.count as usize),
-        None => plan.lines(),
-    };
-    let todo: Vec<SweepLine> =
-        mine.iter().filter(|l| !done.iter().any(|d| d.line == l.index)).cloned().collect();
-    let total: usize = mine.iter().map(|l| l.points.len()).sum();
-    let resumed: usize = done.iter().map(|d| d.samples.len()).sum();
+    let sweep = Sweep::resume(&plan, key, shard, &checkpoint_path)?;
+    let (total, resumed) = (sweep.sample_count(), sweep.resumed_count());
     eprintln!(
         "sampling '{}' with '{}': {total} of {} samples in {} sweep lines{}{}",
         pattern.name,
         model.name,
         plan.sample_count(),
-        mine.len(),
+        sweep.line_count(),
         shard.map(|s| format!(" (shard {}/{})", s.index, s.count)).unwrap_or_default(),
         if resumed > 0 {
             format!(", {resumed} resumed from {}", checkpoint_path.display())
@@ -167,21 +155,12 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     );
     let started = Instant::now();
     let trace = args.trace.as_deref().map(|path| open_trace(path, &trace_metadata(&args))).transpose()?;
-    let recorder = Recorder::new(checkpoint, trace, progress_bar(total as u64, resumed as u64));
-    let results =
-        sample_lines(&tile, &plan, &todo, &options, &|line| recorder.record(&plan, &pattern, &tile, line));
-    let (checkpoint, trace) = recorder.finish()?;
+    let bar = progress_bar(total as u64, "samples");
+    bar.set_position(resumed as u64);
+    let swept = sweep.run(&tile, &pattern, &options, trace, &|n| bar.inc(n as u64));
+    bar.finish_and_clear();
+    let Swept { grid, checkpoint, trace } = swept?;
     finish_trace(trace, args.trace.as_deref())?;
-    let mut samples: Vec<GridSample> = done.into_iter().flat_map(|d| d.samples).collect();
-    samples.extend(results.iter().flat_map(|l| l.samples.iter().map(SampleOutcome::to_grid_sample)));
-    samples.sort_by_key(GridSample::key);
-    let grid = Grid {
-        pattern: pattern.name.clone(),
-        model: model.name.clone(),
-        terms: plan.grid_terms(),
-        shard,
-        samples,
-    };
     write_artifact(&output, &grid, "rve sample", inputs)?;
     checkpoint.remove()?;
     let converged = grid.samples.iter().filter(|s| s.converged).count();
@@ -205,84 +184,6 @@ fn trace_metadata(args: &SampleArgs) -> TraceMetadata {
         .with_entry("n2d", args.n2d.to_string())
 }
 
-/// What the sweep does with each finished line, from whichever thread finished it: append it
-/// to the checkpoint, record its samples on the trace (numbered in completion order), advance
-/// the progress bar. The first error is kept and reported when the sweep is done.
-struct Recorder {
-    checkpoint: Mutex<Checkpoint>,
-    trace: Mutex<(Option<TraceSink>, u64)>,
-    error: Mutex<Option<anyhow::Error>>,
-    bar: ProgressBar,
-}
-
-impl Recorder {
-    fn new(checkpoint: Checkpoint, trace: Option<TraceSink>, bar: ProgressBar) -> Self {
-        Recorder {
-            checkpoint: Mutex::new(checkpoint),
-            trace: Mutex::new((trace, 0)),
-            error: Mutex::new(None),
-            bar,
-        }
-    }
-
-    fn record(&self, plan: &SamplePlan, pattern: &Pattern, tile: &RveModel, line: &LineResult) {
-        let mut trace = lock(&self.trace);
-        let (sink, written) = &mut *trace;
-        if let Some(sink) = sink.as_mut()
-            && let Err(e) = record_line(sink, written, plan, pattern, tile, line)
-        {
-            lock(&self.error).get_or_insert(anyhow::Error::new(e).context("cannot write the trace"));
-        }
-        drop(trace);
-        let record = CheckpointLine {
-            line: line.line,
-            samples: line.samples.iter().map(SampleOutcome::to_grid_sample).collect(),
-        };
-        if let Err(e) = lock(&self.checkpoint).append(&record) {
-            lock(&self.error).get_or_insert(e.into());
-        }
-        self.bar.inc(line.samples.len() as u64);
-    }
-
-    /// The checkpoint and the trace back, or the first error met.
-    fn finish(self) -> anyhow::Result<(Checkpoint, Option<TraceSink>)> {
-        self.bar.finish_and_clear();
-        if let Some(e) = into_inner(self.error) {
-            return Err(e);
-        }
-        Ok((into_inner(self.checkpoint), into_inner(self.trace).0))
-    }
-}
-
-/// A mutex's value, whether or not a thread panicked holding it.
-fn lock<T>(mutex: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
-    mutex.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-fn into_inner<T>(mutex: Mutex<T>) -> T {
-    mutex.into_inner().unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-/// Writes the samples of a finished line to the trace, numbering them on from `written`.
-fn record_line(
-    sink: &mut TraceSink,
-    written: &mut u64,
-    plan: &SamplePlan,
-    pattern: &Pattern,
-    tile: &RveModel,
-    line: &LineResult,
-) -> Result<(), TraceError> {
-    for s in &line.samples {
-        let frame = *written;
-        *written += 1;
-        sink.write(&sample_message(plan, s, frame))?;
-        if let (Some(positions), Some(twists)) = (&s.positions_m, &s.edge_twist_rad) {
-            sink.write(&yarns_in_order(pattern, tile, positions, twists, frame))?;
-        }
-    }
-    sink.end_frame()
-}
-
 /// `K/N` with `0 <= K < N`.
 fn parse_shard(text: &str) -> anyhow::Result<GridShard> {
     let parse = || -> Option<GridShard> {
@@ -291,14 +192,4 @@ fn parse_shard(text: &str) -> anyhow::Result<GridShard> {
         (index < count).then_some(GridShard { index, count })
     };
     parse().ok_or_else(|| anyhow::anyhow!("--shard {text}: expected K/N with 0 <= K < N, e.g. 3/16"))
-}
-
-fn progress_bar(total: u64, done: u64) -> ProgressBar {
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} samples, {elapsed} elapsed, ETA {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar.set_position(done);
-    bar
 }

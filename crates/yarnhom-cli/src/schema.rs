@@ -6,7 +6,7 @@ use clap::Args;
 use yarnhom_artifacts::{KINDS, json_schema, schema, schema_version};
 
 use crate::Outcome;
-use crate::output::write_text;
+use crate::output::{create_dir, write_text};
 
 #[derive(Debug, Args)]
 pub struct SchemaArgs {
@@ -51,7 +51,7 @@ pub fn run(args: SchemaArgs) -> anyhow::Result<Outcome> {
             write_text(&path, &text)?;
         }
         let trace_dir = dir.join("trace");
-        std::fs::create_dir_all(&trace_dir)?;
+        create_dir(&trace_dir)?;
         for (_, name, schema) in yarnhom_trace::topic_schemas() {
             let path = trace_dir.join(format!("{name}.schema.json"));
             let text = serde_json::to_string_pretty(&schema)? + "\n";

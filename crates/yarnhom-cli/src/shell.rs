@@ -1,19 +1,16 @@
 //! `yarnhom shell ...`: thin-shell cloth simulation with homogenized or Ch. 6 materials.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::{Args, Subcommand};
-use indicatif::{ProgressBar, ProgressStyle};
-use yarnhom_artifacts::AtomicFile;
 use yarnhom_shell::elastic::NewtonMatrix;
-use yarnhom_shell::messages::{frame_messages, topology};
-use yarnhom_shell::simulate::{FrameReport, RunTotals, run as run_scene};
-use yarnhom_shell::{LinearSolver, Scene, Simulation, open_material};
-use yarnhom_trace::{TraceError, TraceMetadata, TraceSink};
+use yarnhom_shell::messages::record_frame;
+use yarnhom_shell::simulate::{RunTotals, run as run_scene, write_obj};
+use yarnhom_shell::{LinearSolver, Scene, open_material};
+use yarnhom_trace::TraceMetadata;
 
 use crate::Outcome;
-use crate::output::{finish_trace, open_trace, write_bytes};
+use crate::output::{create_dir, finish_trace, open_trace, progress_bar, write_bytes};
 
 #[derive(Debug, Subcommand)]
 pub enum ShellCommand {
@@ -53,52 +50,12 @@ pub struct SimulateArgs {
     /// The Newton matrix (overrides the scene): the projected element Hessians (Sec. 4.2) or
     /// Gauss-Newton in the forms (faster, no 18 x 18 eigensolver; the same states).
     #[arg(long, value_enum)]
-    pub newton_matrix: Option<NewtonMatrixArg>,
+    pub newton_matrix: Option<NewtonMatrix>,
     /// The Newton system's solver (overrides the scene): `auto` takes Jacobi-preconditioned
     /// conjugate gradients where their bound iteration count costs less than a sparse Cholesky
     /// factorization (short time steps), else the factorization.
     #[arg(long, value_enum)]
-    pub linear_solver: Option<LinearSolverArg>,
-}
-
-/// [`LinearSolver`] on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum LinearSolverArg {
-    /// Conjugate gradients where their bound iteration count costs less than a factorization,
-    /// else Cholesky (the default).
-    Auto,
-    /// Sparse Cholesky for every solve.
-    Cholesky,
-    /// Conjugate gradients for every solve (Cholesky only where they fail).
-    ConjugateGradient,
-}
-
-impl From<LinearSolverArg> for LinearSolver {
-    fn from(arg: LinearSolverArg) -> Self {
-        match arg {
-            LinearSolverArg::Auto => LinearSolver::Auto,
-            LinearSolverArg::Cholesky => LinearSolver::Cholesky,
-            LinearSolverArg::ConjugateGradient => LinearSolver::ConjugateGradient,
-        }
-    }
-}
-
-/// [`NewtonMatrix`] on the command line.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum NewtonMatrixArg {
-    /// The exact element Hessians with their eigenvalues made absolute.
-    Projected,
-    /// Gauss-Newton in the forms, positive semidefinite by construction (the default).
-    GaussNewton,
-}
-
-impl From<NewtonMatrixArg> for NewtonMatrix {
-    fn from(arg: NewtonMatrixArg) -> Self {
-        match arg {
-            NewtonMatrixArg::Projected => NewtonMatrix::Projected,
-            NewtonMatrixArg::GaussNewton => NewtonMatrix::GaussNewton,
-        }
-    }
+    pub linear_solver: Option<LinearSolver>,
 }
 
 #[derive(Debug, Args)]
@@ -131,18 +88,14 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
         .with_entry("newton_matrix", serde_json::to_value(scene.newton_matrix)?.as_str().unwrap_or_default())
         .with_entry("linear_solver", serde_json::to_value(scene.linear_solver)?.as_str().unwrap_or_default());
     let mut trace = open_trace(&args.output, &metadata)?;
-    let bar =
-        progress_bar(args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64));
+    let frames = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
+    let bar = progress_bar(frames, "frames");
     if let Some(dir) = &args.obj_dir {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        create_dir(dir)?;
     }
     let mut totals = RunTotals::default();
     let sim = run_scene(&scene, material, args.frames, |report, sim| {
-        if report.frame == 0 {
-            trace.write(&topology(sim, &scene.name)).map_err(|e| e.to_string())?;
-        }
-        write_frame(&mut trace, report, sim, &scene.name).map_err(|e| e.to_string())?;
-        trace.end_frame().map_err(|e| e.to_string())?;
+        record_frame(&mut trace, report, sim, &scene.name).map_err(|e| e.to_string())?;
         if let Some(dir) = &args.obj_dir {
             write_obj(&dir.join(format!("frame_{:04}.obj", report.frame)), sim).map_err(|e| e.to_string())?;
         }
@@ -153,17 +106,7 @@ fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     })?;
     bar.finish_and_clear();
     finish_trace(Some(trace), Some(&args.output))?;
-    eprintln!(
-        "simulated {} s in {} steps ({} Newton iterations; linear solves: {} conjugate gradient iterations, {} \
-         Cholesky factorizations), {} vertices; elastic energy {:.4e} J",
-        sim.time_s,
-        totals.steps,
-        totals.newton_iterations,
-        totals.cg_iterations,
-        totals.factorizations,
-        sim.positions.len(),
-        sim.model.energy(&sim.positions)
-    );
+    eprintln!("{}", totals.summary(&sim));
     Ok(Outcome::Success)
 }
 
@@ -174,38 +117,7 @@ fn scene_of(args: &SimulateArgs) -> anyhow::Result<Scene> {
         scene.vertices = [n, n];
     }
     scene.steps_per_frame = args.steps_per_frame.unwrap_or(scene.steps_per_frame);
-    scene.newton_matrix = args.newton_matrix.map_or(scene.newton_matrix, NewtonMatrix::from);
-    scene.linear_solver = args.linear_solver.map_or(scene.linear_solver, LinearSolver::from);
+    scene.newton_matrix = args.newton_matrix.unwrap_or(scene.newton_matrix);
+    scene.linear_solver = args.linear_solver.unwrap_or(scene.linear_solver);
     Ok(scene)
-}
-
-fn progress_bar(frames: u64) -> ProgressBar {
-    let bar = ProgressBar::new(frames);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} frame {pos}/{len}, {elapsed} elapsed, ETA {eta} {msg}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
-    );
-    bar
-}
-
-/// Writes one frame's messages to the trace.
-fn write_frame(
-    trace: &mut TraceSink,
-    report: &FrameReport,
-    sim: &Simulation,
-    name: &str,
-) -> Result<(), TraceError> {
-    let (mesh, scalars, steps) = frame_messages(report, sim, name);
-    trace.write(&mesh)?;
-    trace.write(&scalars)?;
-    steps.iter().try_for_each(|step| trace.write(step))
-}
-
-/// One frame as a Wavefront OBJ with material coordinates as texture coordinates.
-fn write_obj(path: &Path, sim: &Simulation) -> std::io::Result<()> {
-    let positions: Vec<[f64; 3]> = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
-    let texcoords: Vec<[f64; 2]> = sim.model.mesh.material.iter().map(|m| [m.x, m.y]).collect();
-    let mut out = AtomicFile::create(path)?;
-    yarnhom_trace::export::write_obj(&mut out, &positions, &texcoords, &sim.model.mesh.triangles)?;
-    out.commit()
 }

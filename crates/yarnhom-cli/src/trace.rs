@@ -8,7 +8,7 @@ use std::ops::Range;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use yarnhom_trace::filter::{self, FilterStats, Selection};
+use yarnhom_trace::filter::{self, FilterStats, Selection, parse_range};
 use yarnhom_trace::{TraceMetadata, open_records};
 
 use crate::Outcome;
@@ -53,11 +53,11 @@ pub struct SelectArgs {
     #[arg(long = "topic", value_name = "TOPIC")]
     pub topics: Vec<String>,
     /// Frames to keep, `A:B` (A included, B excluded; either may be left out).
-    #[arg(long, value_name = "A:B")]
-    pub frames: Option<String>,
+    #[arg(long, value_name = "A:B", value_parser = frame_range)]
+    pub frames: Option<Range<u64>>,
     /// Simulated times to keep in seconds, `A:B` (A included, B excluded; either may be left out).
-    #[arg(long, value_name = "A:B")]
-    pub time: Option<String>,
+    #[arg(long, value_name = "A:B", value_parser = time_range)]
+    pub time: Option<Range<f64>>,
 }
 
 #[derive(Debug, Args)]
@@ -87,20 +87,8 @@ pub fn run(cmd: TraceCommand) -> anyhow::Result<Outcome> {
     match cmd {
         TraceCommand::Info(args) => info(args),
         TraceCommand::Select(args) => {
-            let selection = Selection {
-                topics: args.topics,
-                frames: args
-                    .frames
-                    .as_deref()
-                    .map(|text| parse_range(text, 0, u64::MAX, "--frames"))
-                    .transpose()?,
-                time_s: args
-                    .time
-                    .as_deref()
-                    .map(|text| parse_range(text, 0.0, f64::INFINITY, "--time"))
-                    .transpose()?,
-                every: None,
-            };
+            let selection =
+                Selection { topics: args.topics, frames: args.frames, time_s: args.time, every: None };
             let command = "trace select";
             run_filter(&args.input, &args.output, command, &selection)
         }
@@ -170,37 +158,13 @@ fn report(command: &str, stats: &FilterStats, inputs: &[String]) {
 }
 
 /// Parses `A:B` with either end optional into a half-open range.
-fn parse_range<T>(text: &str, lowest: T, highest: T, flag: &str) -> anyhow::Result<Range<T>>
-where
-    T: std::str::FromStr + PartialOrd + Copy,
-{
-    let (a, b) = text
-        .split_once(':')
-        .with_context(|| format!("{flag} {text}: expected A:B (either may be left out, e.g. 10: or :2.5)"))?;
-    let parse = |part: &str, default: T| -> anyhow::Result<T> {
-        if part.trim().is_empty() {
-            return Ok(default);
-        }
-        part.trim().parse().map_err(|_| anyhow::anyhow!("{flag} {text}: '{part}' is not a valid bound"))
-    };
-    let (start, end) = (parse(a, lowest)?, parse(b, highest)?);
-    anyhow::ensure!(start < end, "{flag} {text}: the range is empty (A must be below B)");
-    Ok(start..end)
+
+/// `--frames A:B`.
+fn frame_range(text: &str) -> Result<Range<u64>, String> {
+    parse_range(text, 0, u64::MAX)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::parse_range;
-
-    #[test]
-    fn ranges_parse_with_open_ends_and_reject_empty_or_bad_ones() {
-        assert_eq!(parse_range("2:5", 0, u64::MAX, "--frames").ok(), Some(2..5));
-        assert_eq!(parse_range(":5", 0, u64::MAX, "--frames").ok(), Some(0..5));
-        assert_eq!(parse_range("7:", 0, u64::MAX, "--frames").ok(), Some(7..u64::MAX));
-        assert_eq!(parse_range("0.5:1.5", 0.0, f64::INFINITY, "--time").ok(), Some(0.5..1.5));
-        assert!(parse_range("5:5", 0, u64::MAX, "--frames").is_err());
-        assert!(parse_range("5", 0, u64::MAX, "--frames").is_err());
-        assert!(parse_range("a:3", 0, u64::MAX, "--frames").is_err());
-        assert!(parse_range("-1:3", 0, u64::MAX, "--frames").is_err());
-    }
+/// `--time A:B` (seconds).
+fn time_range(text: &str) -> Result<Range<f64>, String> {
+    parse_range(text, 0.0, f64::INFINITY)
 }

@@ -494,7 +494,11 @@ fn fit_writes_a_spline_that_reproduces_its_grid_and_plots_it() {
     let svgs = std::fs::read_dir(dir.path().join("figures")).expect("figures").count();
     assert_eq!(svgs, 14, "one figure per term of the grid");
     assert_eq!(stderr(&o).lines().filter(|l| l.ends_with(".svg")).count(), 14, "each named as written");
-    fails_with(&["fit", "synthetic.spline.yh", "-o", "x.spline.yh"], dir.path(), "not a grid");
+    fails_with(
+        &["fit", "synthetic.spline.yh", "-o", "x.spline.yh"],
+        dir.path(),
+        "expected a 'grid' artifact but the file holds 'spline'",
+    );
     let limited =
         ok(&["fit", "synthetic.grid.yh", "--limit", "kx=-100:150", "-o", "limited.spline.yh"], dir.path());
     assert!(limited.contains("samples used"), "{limited}");
@@ -770,7 +774,7 @@ fn diff_of_a_missing_file_or_of_other_kinds_exits_2() {
         ],
         d,
     );
-    fails_with(&["diff", "t.mcap", pattern], d, "cannot compare a trace");
+    fails_with(&["diff", "t.mcap", pattern], d, "cannot compare a MCAP trace (t.mcap) with a 'pattern'");
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! compare`): e.g. our fit of a published pattern against the published fit of it.
 
 use yarnhom_artifacts::Spline;
+use yarnhom_artifacts::grid::AXIS_NAMES;
 use yarnhom_geom::stats::{correlation, root_mean_square};
 
 use crate::SplineMaterial;
@@ -45,6 +46,29 @@ pub fn compare_1d_terms(a: &Spline, b: &Spline) -> Vec<TermComparison> {
             })
         })
         .collect()
+}
+
+/// The comparison of `a` and `b` as `yarnhom fit compare` prints it: a table of
+/// [`compare_1d_terms`], a row per term.
+pub fn comparison_report(a: &Spline, b: &Spline) -> String {
+    let mut report = format!(
+        "1D terms of '{}' and '{}' (energy relative to rest, J/m²) over the strains both were fitted on:\n",
+        a.name, b.name
+    );
+    report += "  term  range                 RMS first  RMS second  RMS difference  shape correlation";
+    for c in compare_1d_terms(a, b) {
+        report += &format!(
+            "\n  {:4}  [{:8.3}, {:8.3}]  {:10.4e} {:11.4e} {:15.4e} {:18.3}",
+            AXIS_NAMES[c.axis],
+            c.range[0],
+            c.range[1],
+            c.rms[0],
+            c.rms[1],
+            c.rms_difference,
+            c.shape_correlation
+        );
+    }
+    report
 }
 
 /// The strain range `[lo, hi]` a spline's 1D term has knots over (its fitted range).

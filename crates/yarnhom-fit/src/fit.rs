@@ -25,7 +25,7 @@ use crate::residual::{residualize_1d, residualize_2d, zero_compressed};
 pub(crate) const SHEAR: usize = 1;
 /// The pair `(sx, sy)` whose residual keeps its shape: no marching, no zeroed compression
 /// (A.3.4, A.3.6), so it carries the Poisson effect.
-const POISSON_PAIR: [usize; 2] = [0, 2];
+pub(crate) const POISSON_PAIR: [u8; 2] = [0, 2];
 /// Fewest converged samples a term is fitted from.
 const MIN_SAMPLES: usize = 4;
 /// The MLS support spans at least this many of the widest gaps between sampled values, so a
@@ -253,7 +253,7 @@ fn fit_2d(
     let i_min = zero_knot_index(&u_knots).ok_or_else(no_zero)?;
     let j0 = zero_knot_index(&v_knots).ok_or_else(no_zero)?;
     move_onto_1d_terms(&mut h, [&u_knots, &v_knots], [i_min, j0], axis_terms);
-    if axes == POISSON_PAIR {
+    if axes.map(|a| a as u8) == POISSON_PAIR {
         // A.3.5: f13 is not marched; its boundary tangents are only made non-decreasing outward.
         clamp_boundary_for_extrapolation_2d(&u_knots, &v_knots, &mut h.du, &mut h.dv, &mut h.duv, 0.0);
     } else {
@@ -280,7 +280,7 @@ fn fit_2d(
     };
     let regularized = term(h.clone());
     residualize_2d(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv).map_err(|_| no_zero())?;
-    if axes != POISSON_PAIR.map(|a| a as u8) {
+    if axes != POISSON_PAIR {
         let compressible = |axis: u8| axis == 0 || axis == 2;
         let (cu, cv) = (compressible(axes[0]), compressible(axes[1]));
         zero_compressed(&u_knots, &v_knots, &mut h.values, &mut h.du, &mut h.dv, &mut h.duv, cu, cv);

@@ -17,7 +17,7 @@ pub mod residual;
 pub mod shape;
 pub mod synthetic;
 
-pub use compare::{TermComparison, compare_1d_terms};
+pub use compare::{TermComparison, compare_1d_terms, comparison_report};
 pub use difference::diff_spline_materials;
 pub use fit::{FitError, RegularizedFit, TermError, fit_errors, fit_grid, fit_grid_with_regularized_terms};
 pub use material::{EnergyJet, SplineMaterial};

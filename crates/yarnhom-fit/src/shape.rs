@@ -13,12 +13,11 @@ use yarnhom_artifacts::grid::{AXIS_NAMES, strain_from_values};
 use yarnhom_artifacts::{BicubicTerm, Grid, GridTerm, Spline, StrainSample};
 
 use crate::SplineMaterial;
+use crate::fit::POISSON_PAIR;
 use crate::hermite::Bicubic;
 
 /// Points per line.
 const POINTS: usize = 1501;
-/// The pair not marched (A.3.4): it carries the Poisson effect.
-const POISSON_PAIR: [u8; 2] = [0, 2];
 
 /// The shape check of one term.
 #[derive(Debug, Clone, PartialEq)]

@@ -25,6 +25,7 @@ use yarnhom_geom::stats::root_mean_square;
 
 /// The in-plane coordinate a mirror negates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MirrorAxis {
     /// `X1 -> -X1`: the mirror plane is parallel to X2 (a knit's wale axis).
     X1,

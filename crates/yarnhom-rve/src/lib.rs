@@ -12,6 +12,7 @@ pub mod relax;
 pub mod residual;
 pub mod sample;
 pub mod solve;
+pub mod sweep;
 
 pub use assembly::Assembled;
 pub use model::{RveError, RveModel};

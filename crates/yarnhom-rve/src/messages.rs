@@ -4,7 +4,7 @@
 
 use yarnhom_artifacts::Pattern;
 use yarnhom_artifacts::grid::AXIS_NAMES;
-use yarnhom_trace::{RveSample, SolverIteration, YarnFrame};
+use yarnhom_trace::{RveSample, SolverIteration, TraceError, TraceSink, YarnFrame};
 
 use crate::assembly::{RveState, world_positions};
 use crate::sample::{SampleOutcome, SamplePlan};
@@ -20,6 +20,20 @@ pub fn yarn_frame(
 ) -> YarnFrame {
     let twists: Vec<f64> = (0..tile.vertices as u32).map(|v| state.g[tile.twist_dof(v)]).collect();
     yarns_in_order(pattern, tile, &world_positions(tile, placement, state), &twists, frame)
+}
+
+/// Records a Newton iterate of the tile (of `pattern`, placed by `placement`) on `sink` as
+/// one frame, numbered by the iteration: [`iteration_message`] and [`yarn_frame`].
+pub fn record_iterate(
+    sink: &mut TraceSink,
+    pattern: &Pattern,
+    tile: &RveModel,
+    placement: &Placement,
+    iterate: &Iterate<'_>,
+) -> Result<(), TraceError> {
+    sink.write(&iteration_message(iterate))?;
+    sink.write(&yarn_frame(pattern, tile, placement, iterate.state, iterate.iteration as u64))?;
+    sink.end_frame()
 }
 
 /// Per-vertex positions and edge twists of the tile (in the tile's vertex order) as frame

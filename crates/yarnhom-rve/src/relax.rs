@@ -100,6 +100,24 @@ pub struct RelaxReport {
     pub iterations: usize,
 }
 
+impl RelaxReport {
+    /// What `yarnhom rve relax` prints of the relaxation that made `relaxed` in `seconds`.
+    pub fn summary(&self, relaxed: &Pattern, seconds: f64) -> String {
+        let [sx, sa, sy] = self.residual_stress_j_m2;
+        format!(
+            "relaxed '{}': {} resets, periods {:.4} x {:.4} mm (period strain {:+.4}, {:+.4}), {} Newton \
+             iterations, {seconds:.1} s\n  in-plane stress at zero strain: dsx {sx:.3e}, dsa {sa:.3e}, dsy {sy:.3e} J/m²",
+            relaxed.name,
+            self.resets,
+            relaxed.period_m[0] * 1e3,
+            relaxed.period_m[1] * 1e3,
+            self.period_strain[0],
+            self.period_strain[1],
+            self.iterations,
+        )
+    }
+}
+
 /// Progress of a relaxation, for a caller's progress display.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum RelaxEvent {
@@ -107,6 +125,21 @@ pub enum RelaxEvent {
     Reset(usize, f64),
     /// A step of the in-plane minimization: the period strain and the in-plane stress there.
     PeriodStep([f64; 2], [f64; 2]),
+}
+
+impl std::fmt::Display for RelaxEvent {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RelaxEvent::Reset(k, energy) => {
+                write!(f, "reset {:>3}: relaxed tile energy {energy:.3e} J", k + 1)
+            }
+            RelaxEvent::PeriodStep(s, sigma) => write!(
+                f,
+                "periods: sx {:+.5} sy {:+.5}, stress {:+.3e} {:+.3e} J/m²",
+                s[0], s[1], sigma[0], sigma[1]
+            ),
+        }
+    }
 }
 
 /// The rest state of `pattern` for `yarn`, computed with `options`; `progress` sees each stage.

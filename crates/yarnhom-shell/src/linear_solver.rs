@@ -35,10 +35,11 @@ const FACTORIZATION_FLOP_SPEEDUP: f64 = 4.0;
 /// How the Newton system is solved.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LinearSolver {
     /// Jacobi-preconditioned conjugate gradients where their bound iteration count costs less
     /// than a factorization (short time steps), else sparse Cholesky; also Cholesky when
-    /// conjugate gradients exceed that cost after all.
+    /// conjugate gradients exceed that cost after all. The default.
     #[default]
     Auto,
     /// Sparse Cholesky (faer, supernodal, on the pattern's symbolic analysis) for every solve.

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep};
+use yarnhom_trace::{MeshFrame, MeshTopology, Scalars, SolverStep, TraceError, TraceSink};
 
 use crate::Simulation;
 use crate::simulate::FrameReport;
@@ -57,4 +57,22 @@ pub fn frame_messages(
         })
         .collect();
     (mesh, scalars, steps)
+}
+
+/// Records output frame `report` of the simulation of mesh `name` on `sink`: the topology
+/// first (frame 0), then [`frame_messages`], and closes the frame.
+pub fn record_frame(
+    sink: &mut TraceSink,
+    report: &FrameReport,
+    sim: &Simulation,
+    name: &str,
+) -> Result<(), TraceError> {
+    if report.frame == 0 {
+        sink.write(&topology(sim, name))?;
+    }
+    let (mesh, scalars, steps) = frame_messages(report, sim, name);
+    sink.write(&mesh)?;
+    sink.write(&scalars)?;
+    steps.iter().try_for_each(|step| sink.write(step))?;
+    sink.end_frame()
 }

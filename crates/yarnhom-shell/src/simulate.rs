@@ -1,6 +1,10 @@
 //! Running a scene: build the mesh, handles and integrator, step to the end time and report
 //! each output frame.
 
+use std::path::Path;
+
+use yarnhom_artifacts::AtomicFile;
+
 use crate::elastic::ElasticModel;
 use crate::integrator::{Simulation, StepError, StepStats};
 use crate::material::ShellMaterial;
@@ -48,6 +52,31 @@ impl RunTotals {
             self.factorizations += u64::from(s.linear_solves.factorizations);
         }
     }
+
+    /// The closing line of a run that ended in state `sim`.
+    pub fn summary(&self, sim: &Simulation) -> String {
+        format!(
+            "simulated {} s in {} steps ({} Newton iterations; linear solves: {} conjugate gradient iterations, \
+             {} Cholesky factorizations), {} vertices; elastic energy {:.4e} J",
+            sim.time_s,
+            self.steps,
+            self.newton_iterations,
+            self.cg_iterations,
+            self.factorizations,
+            sim.positions.len(),
+            sim.model.energy(&sim.positions)
+        )
+    }
+}
+
+/// Writes the state `sim` as a Wavefront OBJ file (positions, the material coordinates as
+/// texture coordinates, the triangles), atomically.
+pub fn write_obj(path: &Path, sim: &Simulation) -> std::io::Result<()> {
+    let positions: Vec<[f64; 3]> = sim.positions.iter().map(|p| [p.x, p.y, p.z]).collect();
+    let texcoords: Vec<[f64; 2]> = sim.model.mesh.material.iter().map(|m| [m.x, m.y]).collect();
+    let mut out = AtomicFile::create(path)?;
+    yarnhom_trace::export::write_obj(&mut out, &positions, &texcoords, &sim.model.mesh.triangles)?;
+    out.commit()
 }
 
 /// Why a run stopped.

@@ -35,6 +35,24 @@ pub struct Selection {
     pub every: Option<u64>,
 }
 
+/// `A:B` as the half-open range `A..B` of [`Selection::frames`] or [`Selection::time_s`];
+/// either end may be left out (`10:`, `:2.5`) for `lowest` or `highest`. An empty range is
+/// refused.
+pub fn parse_range<T>(text: &str, lowest: T, highest: T) -> Result<Range<T>, String>
+where
+    T: std::str::FromStr + PartialOrd + Copy,
+{
+    let (a, b) = text.split_once(':').ok_or("expected A:B (either may be left out, e.g. 10: or :2.5)")?;
+    let parse = |part: &str, default: T| -> Result<T, String> {
+        if part.trim().is_empty() {
+            return Ok(default);
+        }
+        part.trim().parse().map_err(|_| format!("'{part}' is not a valid bound"))
+    };
+    let (start, end) = (parse(a, lowest)?, parse(b, highest)?);
+    if start < end { Ok(start..end) } else { Err("the range is empty (A must be below B)".into()) }
+}
+
 impl Selection {
     /// Whether a message on `topic` passes the topic filter.
     pub fn keeps_topic(&self, topic: &str) -> bool {
@@ -280,6 +298,18 @@ mod tests {
     use std::io::Cursor;
 
     use super::*;
+
+    #[test]
+    fn ranges_parse_with_open_ends_and_reject_empty_or_bad_ones() {
+        assert_eq!(parse_range("2:5", 0, u64::MAX), Ok(2..5));
+        assert_eq!(parse_range(":5", 0, u64::MAX), Ok(0..5));
+        assert_eq!(parse_range("7:", 0, u64::MAX), Ok(7..u64::MAX));
+        assert_eq!(parse_range("0.5:1.5", 0.0, f64::INFINITY), Ok(0.5..1.5));
+        assert!(parse_range("5:5", 0, u64::MAX).is_err());
+        assert!(parse_range("5", 0, u64::MAX).is_err());
+        assert!(parse_range("a:3", 0, u64::MAX).is_err());
+        assert!(parse_range("-1:3", 0, u64::MAX).is_err());
+    }
     use crate::{
         MeshFrame, MeshTopology, Scalars, TraceMessage, TraceMetadata, TraceReader, TraceWriterOptions,
     };

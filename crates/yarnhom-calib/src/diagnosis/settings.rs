@@ -36,12 +36,19 @@ impl Default for DiagnoseSettings {
 /// Time against confidence: the swatch mesh and optimizer iterations of every model, and the
 /// size of the yarn-level confirmation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Budget {
-    /// 8 mm swatches, 10 iterations per model; no yarn-level confirmation.
+    /// Coarse swatches (8 mm), 10 optimizer iterations per model; no yarn-level confirmation.
     Quick,
-    /// 5 mm swatches, 30 iterations per model; a reduced confirmation ([`SearchSize::Reduced`]).
+    /// 5 mm swatches, 30 iterations per model; the cause confirmed on the tile by a reduced
+    /// yarn-level fit (swarm 16 x 3 on 5 targets per direction, Gauss-Newton 8 Jacobians on 8).
+    ///
+    /// [`SearchSize::Reduced`].
     Normal,
-    /// 3.5 mm swatches, 80 iterations per model; the full confirmation ([`SearchSize::Full`]).
+    /// 3.5 mm swatches, 80 iterations per model; the confirmation by the full yarn-level fit
+    /// (swarm 64 x 10 on 7 targets, Gauss-Newton 20 Jacobians on 20).
+    ///
+    /// [`SearchSize::Full`].
     Thorough,
 }
 

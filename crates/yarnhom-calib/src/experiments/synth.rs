@@ -16,15 +16,20 @@ use crate::data::set::{
 
 /// An effect hidden in a synthetic set, beyond the plain anisotropic StVK base.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum HiddenEffect {
     /// Nothing: the base model is the truth.
     None,
     /// The Neo-Hookean area terms of (6.1).
     AreaPreservation,
-    /// Stiffening past an onset strain ([`yarnhom_shell::Stiffening`]).
+    /// Stiffening past an onset strain.
+    ///
+    /// [`yarnhom_shell::Stiffening`].
     BiphasicStretch,
-    /// Jamming past an onset compression ([`StvkNeoHookean::jamming`]), the shell-level trace
-    /// of two-phase yarn contact: the contraction across the pull stops growing near 2%.
+    /// Jamming past an onset compression, the shell-level trace of two-phase yarn contact: the
+    /// contraction across the pull stops growing near 2%.
+    ///
+    /// [`StvkNeoHookean::jamming`].
     TwoPhaseContact,
     /// Unloading readings below loading: a friction force `2 h f_max` opposes the unloading
     /// swatch (a constant offset, not the multiplicative form the diagnosis fits).
@@ -33,10 +38,11 @@ pub enum HiddenEffect {
     RestCurvature,
     /// Bending stiffness differs by direction (weft stiffer than warp).
     AnisotropicBending,
-    /// Not in the diagnosis' catalog: the fabric softens past an onset strain (a negative
-    /// [`Stiffening`] taking 70% of the weft and warp stiffness away), so the force rises
+    /// Off the diagnosis' catalog: the fabric softens past an onset strain, so the force rises
     /// slower than any strain-independent membrane allows; an honest diagnosis says
     /// `unexplained`.
+    ///
+    /// A negative [`Stiffening`] taking 70% of the weft and warp stiffness away.
     Softening,
 }
 

@@ -33,13 +33,16 @@ const PRIOR_WEIGHT: f64 = 1e-2;
 /// Which terms of (6.1) are fitted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum MembraneModel {
     /// Plain anisotropic StVK (`k_n1 = k_n2 = 0`).
     Stvk,
     /// Anisotropic StVK with the Neo-Hookean area terms (6.1).
     StvkNeoHookean,
-    /// (6.1) with jamming past an onset compression ([`StvkNeoHookean::jamming`]): the
-    /// extension the diagnosis names `two-phase-contact` (beyond the thesis).
+    /// (6.1) with jamming past an onset compression: the extension the diagnosis names
+    /// `two-phase-contact` (beyond the thesis).
+    ///
+    /// [`StvkNeoHookean::jamming`].
     StvkNeoHookeanJamming,
 }
 

@@ -13,15 +13,20 @@ use crate::optimize::swarm::SwarmSettings;
 /// The local optimizer.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "kebab-case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum LocalSolver {
     /// COBYLA (Powell 1994), derivative-free, as the thesis.
     Cobyla,
     /// Levenberg-Marquardt on the residuals of (6.11), Jacobian by finite differences of whole
     /// evaluations.
+    #[cfg_attr(feature = "clap", value(name = "lm"))]
     LevenbergMarquardt,
     /// Gauss-Newton / Levenberg-Marquardt with the Jacobian from the parameter sensitivities of
-    /// the tile's equilibrium ([`YarnProblem::evaluate_with_jacobian`]), alternated with the
-    /// rest-shape estimation: each round holds the rest shape estimated at its start.
+    /// the tile's equilibrium (one evaluation per Jacobian instead of one per parameter),
+    /// alternated with the rest-shape estimation: each round holds the rest shape estimated at
+    /// its start.
+    ///
+    /// [`YarnProblem::evaluate_with_jacobian`].
     GaussNewton,
     /// No local step (the swarm's best is the result).
     None,
