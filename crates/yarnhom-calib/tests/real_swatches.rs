@@ -69,10 +69,10 @@ fn real_acrylic_swatches_fit_and_diagnose() {
         100.0 * mean(&jammed_compression)
     );
     // Thesis Sec. 6.3.1 over 33 fabrics: 17.59% force, 16.84% compression. With (6.1) alone
-    // force is met and compression is not (20.6%, README), guarded here against getting worse;
-    // with the jamming the diagnosis finds (`two-phase-contact`), both are met.
+    // these four meet the force figure and miss the compression one (the discrepancy the
+    // diagnosis names); with the jamming it finds (`two-phase-contact`) they meet both.
     assert!(mean(&force) <= 0.1759, "force error {}", mean(&force));
-    assert!(mean(&compression) <= 0.22, "compression error {}", mean(&compression));
+    assert!(mean(&compression) > 0.1684, "(6.1) alone meets the compression figure: {}", mean(&compression));
     assert!(mean(&jammed_force) <= 0.1759, "force error with jamming {}", mean(&jammed_force));
     assert!(
         mean(&jammed_compression) <= 0.1684,

@@ -157,8 +157,6 @@ fn report(command: &str, stats: &FilterStats, inputs: &[String]) {
     );
 }
 
-/// Parses `A:B` with either end optional into a half-open range.
-
 /// `--frames A:B`.
 fn frame_range(text: &str) -> Result<Range<u64>, String> {
     parse_range(text, 0, u64::MAX)

@@ -481,7 +481,7 @@ pub fn fit_errors(
                     .collect()
             };
             let all = pairs(&|_| true, &|s| s.energy_density_j_m2);
-            let uncompressed = term.axes.len() == 1 || term.axes.as_slice() == POISSON_PAIR.map(|a| a as u8);
+            let uncompressed = term.axes.len() == 1 || term.axes.as_slice() == POISSON_PAIR;
             let modelled = pairs(
                 &|s: &GridSample| uncompressed || (s.strain.sx >= 0.0 && s.strain.sy >= 0.0),
                 &modelled_energy,

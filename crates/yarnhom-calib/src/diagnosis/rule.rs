@@ -55,6 +55,49 @@ impl Default for DecisionRule {
     }
 }
 
+impl DecisionRule {
+    /// The rule as a Markdown table, a row per threshold (the table `docs/methods.md` holds).
+    pub fn markdown(&self) -> String {
+        let rows = [
+            (
+                "heldout_ratio",
+                self.heldout_ratio,
+                "a candidate's held-out error is below this fraction of its track base's",
+            ),
+            (
+                "noise_margin",
+                self.noise_margin,
+                "... and below it by more than this many times the track's noise",
+            ),
+            (
+                "criterion_drop",
+                self.criterion_drop,
+                "its Akaike criterion on the fitted targets drops by more than this",
+            ),
+            (
+                "max_excess_left",
+                self.max_excess_left,
+                "it leaves at most this fraction of the base's held-out error above the noise (else: a partial explanation)",
+            ),
+            (
+                "none_noise_multiple",
+                self.none_noise_multiple,
+                "no candidate passing: `none` when every base's held-out error is within this many times its noise ...",
+            ),
+            (
+                "none_floor",
+                self.none_floor,
+                "... or within this held-out error, whichever is larger; else `unexplained`",
+            ),
+        ];
+        let mut table = "| `DecisionRule` field | default | test |\n|---|---|---|\n".to_string();
+        for (field, value, test) in rows {
+            table += &format!("| `{field}` | {value} | {test} |\n");
+        }
+        table
+    }
+}
+
 /// What a candidate is judged against: the stretch track's base and noise, and the bending
 /// track when the set has one.
 pub(super) struct Tracks<'a> {
@@ -247,6 +290,17 @@ fn fraction_in_words(fraction: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_methods_documentation_states_the_rule_the_code_applies() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/methods.md");
+        let doc = std::fs::read_to_string(path).expect("docs/methods.md");
+        let table = DecisionRule::default().markdown();
+        assert!(
+            doc.contains(&table),
+            "docs/methods.md must hold DecisionRule::default().markdown():\n{table}"
+        );
+    }
 
     #[test]
     fn the_default_rule_words_its_tests_as_the_reports_always_have() {
