@@ -141,17 +141,10 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     let sweep = Sweep::resume(&plan, key, shard, &checkpoint_path)?;
     let (total, resumed) = (sweep.sample_count(), sweep.resumed_count());
     eprintln!(
-        "sampling '{}' with '{}': {total} of {} samples in {} sweep lines{}{}",
+        "sampling '{}' with '{}': {}",
         pattern.name,
         model.name,
-        plan.sample_count(),
-        sweep.line_count(),
-        shard.map(|s| format!(" (shard {}/{})", s.index, s.count)).unwrap_or_default(),
-        if resumed > 0 {
-            format!(", {resumed} resumed from {}", checkpoint_path.display())
-        } else {
-            String::new()
-        }
+        describe(&sweep, &plan, shard, &checkpoint_path)
     );
     let started = Instant::now();
     let trace = args.trace.as_deref().map(|path| open_trace(path, &trace_metadata(&args))).transpose()?;
@@ -174,6 +167,20 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     print_summary(&summary, args.trace.as_deref());
     wrote(&output);
     Ok(Outcome::Success)
+}
+
+/// `N of M samples in L sweep lines (shard K/N), R resumed from CHECKPOINT`.
+fn describe(sweep: &Sweep<'_>, plan: &SamplePlan, shard: Option<GridShard>, checkpoint: &Path) -> String {
+    let (total, resumed) = (sweep.sample_count(), sweep.resumed_count());
+    let mut text =
+        format!("{total} of {} samples in {} sweep lines", plan.sample_count(), sweep.line_count());
+    if let Some(s) = shard {
+        text += &format!(" (shard {}/{})", s.index, s.count);
+    }
+    if resumed > 0 {
+        text += &format!(", {resumed} resumed from {}", checkpoint.display());
+    }
+    text
 }
 
 fn trace_metadata(args: &SampleArgs) -> TraceMetadata {

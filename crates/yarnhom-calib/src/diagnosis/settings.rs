@@ -43,12 +43,12 @@ pub enum Budget {
     /// 5 mm swatches, 30 iterations per model; the cause confirmed on the tile by a reduced
     /// yarn-level fit (swarm 16 x 3 on 5 targets per direction, Gauss-Newton 8 Jacobians on 8).
     ///
-    /// [`SearchSize::Reduced`].
+    /// See [`SearchSize::Reduced`].
     Normal,
     /// 3.5 mm swatches, 80 iterations per model; the confirmation by the full yarn-level fit
     /// (swarm 64 x 10 on 7 targets, Gauss-Newton 20 Jacobians on 20).
     ///
-    /// [`SearchSize::Full`].
+    /// See [`SearchSize::Full`].
     Thorough,
 }
 

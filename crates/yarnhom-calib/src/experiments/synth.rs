@@ -24,12 +24,12 @@ pub enum HiddenEffect {
     AreaPreservation,
     /// Stiffening past an onset strain.
     ///
-    /// [`yarnhom_shell::Stiffening`].
+    /// See [`yarnhom_shell::Stiffening`].
     BiphasicStretch,
     /// Jamming past an onset compression, the shell-level trace of two-phase yarn contact: the
     /// contraction across the pull stops growing near 2%.
     ///
-    /// [`StvkNeoHookean::jamming`].
+    /// See [`StvkNeoHookean::jamming`].
     TwoPhaseContact,
     /// Unloading readings below loading: a friction force `2 h f_max` opposes the unloading
     /// swatch (a constant offset, not the multiplicative form the diagnosis fits).

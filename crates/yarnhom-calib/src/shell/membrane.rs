@@ -42,7 +42,7 @@ pub enum MembraneModel {
     /// (6.1) with jamming past an onset compression: the extension the diagnosis names
     /// `two-phase-contact` (beyond the thesis).
     ///
-    /// [`StvkNeoHookean::jamming`].
+    /// See [`StvkNeoHookean::jamming`].
     StvkNeoHookeanJamming,
 }
 

@@ -26,7 +26,7 @@ pub enum LocalSolver {
     /// alternated with the rest-shape estimation: each round holds the rest shape estimated at
     /// its start.
     ///
-    /// [`YarnProblem::evaluate_with_jacobian`].
+    /// See [`YarnProblem::evaluate_with_jacobian`].
     GaussNewton,
     /// No local step (the swarm's best is the result).
     None,
