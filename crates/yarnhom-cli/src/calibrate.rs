@@ -53,7 +53,7 @@ pub enum CalibrateCommand {
 #[derive(Debug, Args)]
 pub struct PearLoopArgs {
     /// Direction of the strip's long axis.
-    #[arg(long, default_value = "weft", value_parser = parse_direction)]
+    #[arg(long, value_enum, default_value = "weft")]
     pub direction: Direction,
     /// Free length between the clamps (m).
     #[arg(long, default_value_t = 0.10, value_parser = positive)]
@@ -78,10 +78,6 @@ pub struct PearLoopArgs {
     /// Mesh edge length (m).
     #[arg(long, default_value_t = 0.005, value_parser = positive)]
     pub spacing: f64,
-}
-
-fn parse_direction(name: &str) -> Result<Direction, String> {
-    Direction::parse(name).ok_or_else(|| format!("unknown direction '{name}' (weft, bias, warp)"))
 }
 
 #[derive(Debug, Args)]

@@ -61,7 +61,7 @@ pub fn run(args: DiffArgs) -> anyhow::Result<Outcome> {
             };
             (serde_json::to_string_pretty(&d)?, d.report(), d.equal())
         }
-        (Contents::Report(x), Contents::Report(y)) => {
+        (Contents::Report(x), Contents::Report(y)) if x.format == y.format => {
             let d =
                 CalibrationReport::decode(x.document)?.diff(&CalibrationReport::decode(y.document)?, tol)?;
             (serde_json::to_string_pretty(&d)?, d.report(), d.equal())

@@ -30,7 +30,10 @@ pub fn run(args: InspectArgs) -> anyhow::Result<Outcome> {
     match contents {
         Contents::Artifact { header, artifact } => print_artifact(&header, &artifact)?,
         Contents::Membrane(m) => println!("{}", m.summary()),
-        Contents::Report(report) => println!("{}", CalibrationReport::decode(report.document)?.summary()),
+        Contents::Report(report) => {
+            println!("report: {} v{}", report.format, report.version);
+            println!("{}", CalibrationReport::decode(report.document)?.summary());
+        }
         Contents::Trace => println!("an MCAP trace: `yarnhom trace info {}` summarizes it", path.display()),
     }
     Ok(Outcome::Success)

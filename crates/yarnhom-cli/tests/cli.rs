@@ -809,3 +809,25 @@ fn rve_residual_finds_the_published_stockinette_balanced_by_the_table_4_1_contac
         "has no rest state",
     );
 }
+
+const FIXTURES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../fixtures");
+
+#[test]
+fn calibration_reports_of_old_versions_inspect_and_diff_through_their_migrations() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (v1, v2, yarn) = (
+        format!("{FIXTURES}/diagnosis.v1.json"),
+        format!("{FIXTURES}/diagnosis.v2.json"),
+        format!("{FIXTURES}/yarn-fit.v1.json"),
+    );
+    let text = ok(&["inspect", &v1], dir.path());
+    assert!(text.contains("report: yarnhom.diagnosis v1"), "inspect names the report:\n{text}");
+    assert!(text.contains("cause:"), "inspect prints the diagnosis' summary:\n{text}");
+    // A report equals itself; an old file is compared as its migration to the current version.
+    for report in [&v1, &v2, &yarn] {
+        assert_eq!(yarnhom(&["diff", report, report], dir.path()).status.code(), Some(0), "{report}");
+    }
+    let different = yarnhom(&["diff", &v1, &v2], dir.path());
+    assert_eq!(different.status.code(), Some(1), "two diagnoses of different sets: {}", stdout(&different));
+    fails_with(&["diff", &v1, &yarn], dir.path(), "cannot compare a 'yarnhom.diagnosis' report");
+}

@@ -114,6 +114,7 @@ pub type Result<T> = std::result::Result<T, MeasureError>;
 /// In-plane direction of a test, relative to the fabric.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Direction {
     /// Along the courses (knits) or the weft (wovens): `weft`.
     Weft,
