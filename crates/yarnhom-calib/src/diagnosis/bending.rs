@@ -42,6 +42,7 @@ fn bending_result(id: &str, fit: &BendingFit, tests: &BendingTests, note: Option
         error: Some(fit.error),
         heldout_error: fit.heldout_error,
         criterion: Some(criterion(&fitted, fit.parameter_count)),
+        signature: None,
     }
 }
 

@@ -9,7 +9,7 @@ use yarnhom_shell::StvkNeoHookean;
 
 use super::settings::DiagnoseSettings;
 use crate::cause::CauseId;
-use crate::data::targets::Target;
+use crate::data::targets::{Target, TargetChoice};
 use crate::experiments::bending_tests::BendingTest;
 use crate::experiments::swatch::SimulatedReading;
 use crate::yarn::confirm::YarnLevel;
@@ -36,6 +36,49 @@ pub struct ModelResult {
     /// Akaike criterion on the fitted targets, `n ln(RSS/n) + 2k` (absent when not testable).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub criterion: Option<f64>,
+    /// A candidate's signature before and after it (v4; absent for bases and untested models).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub signature: Option<SignatureScore>,
+}
+
+/// What a cause changes in the data, measured before and after a candidate for it: RMS of the
+/// normalized residuals of the signature's quantities, and the RMS of their standard errors.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct SignatureScore {
+    /// What is measured (`paired load/unload force difference`, ...).
+    pub measure: String,
+    /// Its error with the model the candidate extends.
+    pub before: f64,
+    /// Its error with the candidate.
+    pub after: f64,
+    /// Its noise.
+    pub noise: f64,
+}
+
+/// A confirmed cause, in the order of its relative held-out gain.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ConfirmedCause {
+    /// Catalog id.
+    pub id: CauseId,
+    /// What it means.
+    pub explanation: String,
+    /// The step (1-based) that added it.
+    pub step: usize,
+    /// The model with it added (its id: the causes so far, joined by `+`).
+    pub model: ModelResult,
+    /// Held-out errors of the model it extends and of the model with it.
+    pub gain: Gain,
+}
+
+/// One step of the stepwise explanation: the candidates fitted on top of a model.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Step {
+    /// The id of the model the candidates extend.
+    pub model: String,
+    /// The candidates, fitted on top of it.
+    pub candidates: Vec<ModelResult>,
+    /// The candidate added, if one passed.
+    pub added: Option<CauseId>,
 }
 
 impl ModelResult {
@@ -50,6 +93,7 @@ impl ModelResult {
             error: None,
             heldout_error: None,
             criterion: None,
+            signature: None,
         }
     }
 
@@ -107,16 +151,29 @@ pub struct Diagnosis {
     pub fabric: String,
     /// The settings used.
     pub settings: DiagnoseSettings,
-    /// The cause.
+    /// The cause: the first of `causes`, else `none` or `unexplained`.
     pub cause: Cause,
+    /// Every confirmed cause, in order of relative held-out gain (v4).
+    #[serde(default)]
+    pub causes: Vec<ConfirmedCause>,
+    /// Whether the confirmed causes leave a held-out error above the noise (v4).
+    #[serde(default)]
+    pub unexplained_remainder: bool,
     /// The base model.
     pub base: ModelResult,
-    /// The chosen extension, if a candidate was accepted.
+    /// The extended model: the stretch base with every confirmed stretch-track cause (else
+    /// the confirmed bending cause), if a cause was confirmed.
     pub extended: Option<ModelResult>,
-    /// Held-out errors before and after.
+    /// Held-out errors of the base and of the extended model (the first cause's track).
     pub gain: Gain,
-    /// Every candidate of the catalog.
+    /// Every candidate of the catalog, fitted on the bases (the first step).
     pub candidates: Vec<ModelResult>,
+    /// Every step of the stepwise explanation, the first included (v4).
+    #[serde(default)]
+    pub steps: Vec<Step>,
+    /// How the targets were chosen, per direction and phase (v4).
+    #[serde(default)]
+    pub target_choices: Vec<TargetChoice>,
     /// The noise level of the held-out targets (RMS normalized standard error).
     pub noise: f64,
     /// Loading targets.
@@ -162,8 +219,10 @@ pub struct BendingTrack {
 
 /// Format tag of [`Diagnosis`] files.
 pub const DIAGNOSIS_FORMAT: &str = "yarnhom.diagnosis";
-/// Layout version of [`Diagnosis`] files (v3 adds `extended_material` and `yarn_level`).
-pub const DIAGNOSIS_VERSION: u32 = 3;
+/// Layout version of [`Diagnosis`] files (v3 adds `extended_material` and `yarn_level`; v4
+/// `causes`, `steps`, `target_choices`, `unexplained_remainder`, the candidates' signatures and
+/// the targets' standard errors).
+pub const DIAGNOSIS_VERSION: u32 = 4;
 
 /// The JSON Schema of `report.json`.
 pub fn diagnosis_schema() -> schemars::Schema {
@@ -174,15 +233,19 @@ impl Report for Diagnosis {
     const FORMAT: &'static str = DIAGNOSIS_FORMAT;
     const VERSION: u32 = DIAGNOSIS_VERSION;
 
-    /// Version 1 was written before the bending track and version 2 before the yarn-level
-    /// confirmation: both read with the fields they did not have absent (v1: `bending`,
-    /// `extended_material`, `yarn_level`; v2: `extended_material`, `yarn_level`). A v1
-    /// `gain.heldout_error_before` is the stretch base's held-out error, which is what v3 says
-    /// for every cause of a set without bending tests.
+    /// Version 1 was written before the bending track, version 2 before the yarn-level
+    /// confirmation and version 3 before the stepwise explanation: all read with the fields
+    /// they did not have absent (v1: `bending`, `extended_material`, `yarn_level`; v2:
+    /// `extended_material`, `yarn_level`; v1-v3: `steps`, `target_choices`, signatures). Their
+    /// single cause, if a catalog candidate, becomes the one entry of `causes` (step 1, the
+    /// report's `extended` model and `gain`). A v1 `gain.heldout_error_before` is the stretch
+    /// base's held-out error, which is what later versions say for every cause of a set without
+    /// bending tests.
     fn migrate(version: u32, document: serde_json::Value) -> Result<Self, yarnhom_artifacts::Error> {
         let what = match version {
             1 => "diagnosis v1",
             2 => "diagnosis v2",
+            3 => "diagnosis v3",
             _ => {
                 return Err(yarnhom_artifacts::Error::NoMigration {
                     kind: DIAGNOSIS_FORMAT.into(),
@@ -193,12 +256,36 @@ impl Report for Diagnosis {
         };
         let diagnosis: Diagnosis = serde_json::from_value(document)
             .map_err(|e| yarnhom_artifacts::Error::Decode { what, message: e.to_string() })?;
-        Ok(Diagnosis { version: DIAGNOSIS_VERSION, ..diagnosis })
+        let causes = match (&diagnosis.extended, CauseId::CANDIDATES.contains(&diagnosis.cause.id)) {
+            (Some(model), true) => vec![ConfirmedCause {
+                id: diagnosis.cause.id,
+                explanation: diagnosis.cause.explanation.clone(),
+                step: 1,
+                model: model.clone(),
+                gain: diagnosis.gain,
+            }],
+            _ => Vec::new(),
+        };
+        Ok(Diagnosis { version: DIAGNOSIS_VERSION, causes, ..diagnosis })
     }
 
-    /// The cause and its evidence, the held-out gain, the yarn-level verdict.
+    /// How the targets were chosen, the causes with their gains, the evidence, the held-out
+    /// gain, the yarn-level verdict.
     fn summary(&self) -> String {
-        let mut lines = vec![format!("cause: {} ({})", self.cause.id.as_str(), self.cause.explanation)];
+        let mut lines: Vec<String> = self.target_choices.iter().map(|c| format!("targets: {c}")).collect();
+        lines.push(format!("cause: {} ({})", self.cause.id.as_str(), self.cause.explanation));
+        for c in self.causes.iter().skip(1) {
+            lines.push(format!("also: {} ({})", c.id.as_str(), c.explanation));
+        }
+        for c in &self.causes {
+            lines.push(format!(
+                "  {}: held-out error {:.4} -> {:.4} (step {})",
+                c.id.as_str(),
+                c.gain.heldout_error_before,
+                c.gain.heldout_error_after,
+                c.step
+            ));
+        }
         lines.extend(self.cause.evidence.iter().map(|line| format!("  {line}")));
         lines.push(format!(
             "held-out error {:.4} -> {:.4}; {:.1} s",

@@ -9,7 +9,7 @@ use super::report::{ModelResult, Prediction};
 use super::settings::DiagnoseSettings;
 use crate::cause::CauseId;
 use crate::data::set::{MeasurementSet, Phase};
-use crate::data::targets::{Target, TargetPlan, targets};
+use crate::data::targets::{Target, TargetChoice, TargetPlan, targets};
 use crate::experiments::swatch::SimulatedReading;
 use crate::optimize::akaike::criterion;
 use crate::optimize::lm::LmSettings;
@@ -17,14 +17,18 @@ use crate::shell::membrane::{
     DirectionData, Problem, ShellFitError, Terms, fit_membrane, forces_and_compressions, starting_material,
 };
 
-/// The stretch targets of a diagnosis and the problems they make: `n` loading targets per
-/// direction (and as many unloading ones where the set has enough unloading readings), the even
-/// ones of each direction fitted, the odd ones held out.
+/// The stretch targets of a diagnosis and the problems they make: up to `n` loading targets per
+/// direction (and unloading ones where the set has enough unloading readings), chosen from the
+/// readings ([`crate::data::targets`]), the even ones of each direction fitted, the odd ones
+/// held out.
 pub(super) struct Phases {
     pub load_targets: Vec<Target>,
     pub unload_targets: Option<Vec<Target>>,
+    pub choices: Vec<TargetChoice>,
     pub load: Problem,
     pub unload: Option<Problem>,
+    /// Why there are no unloading targets, if there are none.
+    unload_note: Option<String>,
 }
 
 impl Phases {
@@ -35,19 +39,29 @@ impl Phases {
             force_cap_n: settings.force_cap_n,
             phase: Phase::Load,
         };
-        let load_targets = targets(set, &plan)?;
+        let load = targets(set, &plan)?;
         let even = |k: usize| k.is_multiple_of(2);
-        let unload_targets = targets(set, &TargetPlan { phase: Phase::Unload, ..plan }).ok();
-        let load = Problem::new(DirectionData::group(set, &load_targets, even), settings.spacing_m);
+        let (unload_targets, unload_note, unload_choices) = match targets(set, &TargetPlan { phase: Phase::Unload, ..plan }) {
+            Ok(t) => (Some(t.targets), None, t.choices),
+            Err(e) => (None, Some(format!("no unloading targets: {e}")), Vec::new()),
+        };
+        let load_problem = Problem::new(DirectionData::group(set, &load.targets, even), settings.spacing_m);
         let unload = unload_targets
             .as_ref()
             .map(|t| Problem::new(DirectionData::group(set, t, even), settings.spacing_m));
-        Ok(Self { load_targets, unload_targets, load, unload })
+        Ok(Self {
+            load_targets: load.targets,
+            unload_targets,
+            choices: load.choices.into_iter().chain(unload_choices).collect(),
+            load: load_problem,
+            unload,
+            unload_note,
+        })
     }
 
     /// Why the unloading cannot be tested, if it cannot.
-    pub fn unload_note(&self) -> Option<&'static str> {
-        self.unload_targets.is_none().then_some("too few unloading readings to test")
+    pub fn unload_note(&self) -> Option<&str> {
+        self.unload_note.as_deref()
     }
 
     /// Whether each loading target is fitted (else held out), in target order.
@@ -56,43 +70,102 @@ impl Phases {
     }
 }
 
-/// The base of the stretch track: plain anisotropic StVK from its starting material.
-pub(super) fn fit_base(phases: &Phases, lm: &LmSettings) -> Result<Fitted, ShellFitError> {
-    let terms = Terms::default();
-    fit_model(phases, terms, starting_material(&phases.load.data, terms), lm)
+/// Which extensions of the base a stretch-track model has.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub(super) struct Extensions {
+    /// The membrane terms.
+    pub terms: Terms,
+    /// Unloading force `(1 - h)` times the loading force.
+    pub friction: bool,
 }
 
-/// The stretch-track candidate `id` fitted nested from the base's fit (`None` without an
-/// equilibrium, or for friction without unloading targets to fit).
-pub(super) fn fit_candidate(id: CauseId, phases: &Phases, base: &Fitted, lm: &LmSettings) -> Option<Fitted> {
-    match id {
-        CauseId::AreaPreservation | CauseId::BiphasicStretch | CauseId::TwoPhaseContact => {
-            let terms = Terms {
-                area: id == CauseId::AreaPreservation,
-                stiffening: id == CauseId::BiphasicStretch,
-                jamming: id == CauseId::TwoPhaseContact,
-            };
-            // Nested: start at the base's fit with the new terms a thousandth of their
-            // usual starting size, so the extension starts where the base ended.
-            let seed = starting_material(&phases.load.data, terms);
-            let start = StvkNeoHookean {
-                k_n1: 1e-3 * seed.k_n1,
-                k_n2: 1e-3 * seed.k_n2,
-                stiffening: seed.stiffening.map(Stiffening::faint),
-                jamming: seed.jamming.map(Stiffening::faint),
-                ..base.material
-            };
-            fit_model(phases, terms, start, lm).ok()
+impl Extensions {
+    /// These extensions and the one for `id`.
+    fn with(self, id: CauseId) -> Self {
+        let mut e = self;
+        match id {
+            CauseId::AreaPreservation => e.terms.area = true,
+            CauseId::BiphasicStretch => e.terms.stiffening = true,
+            CauseId::TwoPhaseContact => e.terms.jamming = true,
+            CauseId::FrictionHysteresis => e.friction = true,
+            _ => {}
         }
-        CauseId::FrictionHysteresis => hysteresis_factor(phases, &base.unload).map(|factor| Fitted {
-            material: base.material,
-            unload_factor: factor,
-            parameter_count: base.parameter_count + 1,
-            load: base.load.clone(),
-            unload: base.unload.clone(),
-        }),
-        _ => None,
+        e
     }
+}
+
+/// The stretch-track causes, in catalog order.
+pub(super) const STRETCH_CAUSES: [CauseId; 4] =
+    [CauseId::AreaPreservation, CauseId::BiphasicStretch, CauseId::FrictionHysteresis, CauseId::TwoPhaseContact];
+
+/// The base of the stretch track: plain anisotropic StVK from its starting material.
+pub(super) fn fit_base(phases: &Phases, lm: &LmSettings) -> Result<Fitted, ShellFitError> {
+    fit_model(phases, Extensions::default(), &[], lm)
+}
+
+/// The stretch-track candidate `id` fitted on top of `model` (`None` when `model` has it
+/// already, without an equilibrium, or for friction without unloading targets to fit). The
+/// membrane terms are fitted from several starts ([`candidate_starts`]), so that an onset can
+/// leave a start where it does not act; friction's `h` is a least-squares factor on the even
+/// unloading targets.
+pub(super) fn fit_candidate(id: CauseId, phases: &Phases, model: &Fitted, lm: &LmSettings) -> Option<Fitted> {
+    let extensions = model.extensions.with(id);
+    if extensions == model.extensions {
+        return None;
+    }
+    if id == CauseId::FrictionHysteresis {
+        let hysteresis = fit_hysteresis(phases, &model.unload)?;
+        return Some(Fitted { extensions, hysteresis, parameter_count: model.parameter_count + 2, ..model.clone() });
+    }
+    fit_model(phases, extensions, &candidate_starts(id, phases, &model.material), lm).ok()
+}
+
+/// The starts of candidate `id`'s fit on top of `material`: first the nested start (the new
+/// term a thousandth of its usual starting size, so the extension starts where the model
+/// ended; the prior's anchor), then the new term at full size: the area terms at 5%, 30% and
+/// 100% of the mean stiffness; the stiffening as stiff as the StVK axes and five times that,
+/// from 20%, 45% and 70% of the largest Green strain; the jamming as stiff as the mean StVK
+/// stiffness and ten times that, from 10%, 30% and 60% of the largest compressive Green strain.
+fn candidate_starts(id: CauseId, phases: &Phases, material: &StvkNeoHookean) -> Vec<StvkNeoHookean> {
+    let terms = Extensions::default().with(id).terms;
+    let seed = starting_material(&phases.load.data, terms);
+    let nested = StvkNeoHookean {
+        k_n1: if terms.area { 1e-3 * seed.k_n1 } else { material.k_n1 },
+        k_n2: if terms.area { 1e-3 * seed.k_n2 } else { material.k_n2 },
+        stiffening: material.stiffening.or(seed.stiffening.map(Stiffening::faint)),
+        jamming: material.jamming.or(seed.jamming.map(Stiffening::faint)),
+        ..*material
+    };
+    let mean = (material.k_xx * material.k_yy).sqrt();
+    let grid = |onsets: [f64; 3], sizes: [f64; 2], largest: f64, k: (f64, f64)| -> Vec<Stiffening> {
+        sizes
+            .iter()
+            .flat_map(|size| {
+                onsets.map(|f| Stiffening { k_weft: size * k.0, k_warp: size * k.1, onset: (f * largest).max(1e-3) })
+            })
+            .collect()
+    };
+    let full: Vec<StvkNeoHookean> = match id {
+        CauseId::AreaPreservation => {
+            [0.05, 0.3, 1.0].iter().map(|f| StvkNeoHookean { k_n1: f * mean, k_n2: f * mean, ..nested }).collect()
+        }
+        CauseId::BiphasicStretch => {
+            let largest = seed.stiffening.map_or(0.0, |b| 4.0 * b.onset);
+            grid([0.2, 0.45, 0.7], [1.0, 5.0], largest, (material.k_xx, material.k_yy))
+                .into_iter()
+                .map(|b| StvkNeoHookean { stiffening: Some(b), ..nested })
+                .collect()
+        }
+        CauseId::TwoPhaseContact => {
+            let largest = seed.jamming.map_or(0.0, |b| 4.0 * b.onset);
+            grid([0.1, 0.3, 0.6], [1.0, 10.0], largest, (mean, mean))
+                .into_iter()
+                .map(|b| StvkNeoHookean { jamming: Some(b), ..nested })
+                .collect()
+        }
+        _ => Vec::new(),
+    };
+    std::iter::once(nested).chain(full).collect()
 }
 
 /// Residuals of a model's predictions: `(fitted, held out)`, pooled over both phases.
@@ -100,29 +173,65 @@ fn residuals(
     phases: &Phases,
     load: &[Vec<SimulatedReading>],
     unload: &[Vec<SimulatedReading>],
-    unload_factor: f64,
+    hysteresis: Hysteresis,
 ) -> (Vec<f64>, Vec<f64>) {
     let mut fitted = Vec::new();
     let mut heldout = Vec::new();
-    let mut add = |problem: &Problem, readings: &[Vec<SimulatedReading>], factor: f64| {
+    let mut add = |problem: &Problem, readings: &[Vec<SimulatedReading>], hysteresis: Hysteresis| {
         for (d, r) in problem.data.iter().zip(readings) {
             let (f, c) = forces_and_compressions(r);
-            let f: Vec<f64> = f.iter().map(|x| x * factor).collect();
+            let f = hysteresis.unloading(&f);
             fitted.extend(d.residuals(&f, &c, true));
             heldout.extend(d.residuals(&f, &c, false));
         }
     };
-    add(&phases.load, load, 1.0);
+    add(&phases.load, load, Hysteresis::NONE);
     if let Some(u) = &phases.unload {
-        add(u, unload, unload_factor);
+        add(u, unload, hysteresis);
     }
     (fitted, heldout)
 }
 
-/// A fitted model: its material, unloading factor and predictions.
+/// Friction hysteresis: the unloading force `F - h F_ref (F / F_ref)^p`, with `F` the model's
+/// force at the unloading stretch and `F_ref` the direction's largest. `p = 1` takes a fixed
+/// fraction `h` of the loading force; smaller `p` an offset that varies less with the force,
+/// as Coulomb friction does at a normal force that grows slower than the tension.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Hysteresis {
+    /// The offset at the largest force, as a fraction of it.
+    pub h: f64,
+    /// How the offset grows with the force.
+    pub p: f64,
+}
+
+/// The exponents `p` over which the hysteresis is profiled.
+const HYSTERESIS_EXPONENTS: [f64; 4] = [0.25, 0.5, 0.75, 1.0];
+
+impl Hysteresis {
+    /// No hysteresis: unloading as loading.
+    pub const NONE: Hysteresis = Hysteresis { h: 0.0, p: 1.0 };
+
+    /// The offset `h F_ref (F / F_ref)^p` per force of one direction, before `h`.
+    fn shape(p: f64, forces: &[f64]) -> Vec<f64> {
+        let reference = forces.iter().fold(0.0, |a: f64, f| a.max(f.abs())).max(1e-300);
+        forces.iter().map(|f| reference * (f.max(0.0) / reference).powf(p)).collect()
+    }
+
+    /// The unloading forces of one direction from the model's forces at the same stretches.
+    pub fn unloading(&self, forces: &[f64]) -> Vec<f64> {
+        if self.h == 0.0 {
+            return forces.to_vec();
+        }
+        forces.iter().zip(Self::shape(self.p, forces)).map(|(f, b)| f - self.h * b).collect()
+    }
+}
+
+/// A fitted model: its extensions, material, unloading factor and predictions.
+#[derive(Clone)]
 pub(super) struct Fitted {
+    pub extensions: Extensions,
     pub material: StvkNeoHookean,
-    pub unload_factor: f64,
+    pub hysteresis: Hysteresis,
     pub parameter_count: usize,
     pub load: Vec<Vec<SimulatedReading>>,
     pub unload: Vec<Vec<SimulatedReading>>,
@@ -131,7 +240,7 @@ pub(super) struct Fitted {
 impl Fitted {
     /// Its result: parameters by name, errors on the fitted and held-out targets, criterion.
     pub fn result(&self, id: &str, phases: &Phases, note: Option<String>) -> ModelResult {
-        let (fitted, heldout) = residuals(phases, &self.load, &self.unload, self.unload_factor);
+        let (fitted, heldout) = residuals(phases, &self.load, &self.unload, self.hysteresis);
         let m = &self.material;
         let mut params = vec![
             ("k_xx".to_string(), m.k_xx),
@@ -156,8 +265,9 @@ impl Fitted {
                 ("jamming_onset".to_string(), b.onset),
             ]);
         }
-        if self.unload_factor != 1.0 {
-            params.push(("hysteresis_h".to_string(), 1.0 - self.unload_factor));
+        if self.extensions.friction {
+            params.push(("hysteresis_h".to_string(), self.hysteresis.h));
+            params.push(("hysteresis_p".to_string(), self.hysteresis.p));
         }
         ModelResult {
             id: id.into(),
@@ -168,50 +278,64 @@ impl Fitted {
             error: Some(root_mean_square(fitted.iter().copied())),
             heldout_error: Some(root_mean_square(heldout.iter().copied())),
             criterion: Some(criterion(&fitted, self.parameter_count)),
+            signature: None,
         }
     }
 
     /// Its predictions at every target, for figures.
     pub fn prediction(&self, id: &str) -> Prediction {
-        let scale = |r: &SimulatedReading| SimulatedReading { force_n: r.force_n * self.unload_factor, ..*r };
-        Prediction {
-            id: id.into(),
-            load: self.load.iter().flatten().copied().collect(),
-            unload: self.unload.iter().flatten().map(scale).collect(),
-        }
+        let unload = self.unload.iter().flat_map(|readings| {
+            let (forces, _) = forces_and_compressions(readings);
+            let unloading = self.hysteresis.unloading(&forces);
+            readings.iter().zip(unloading).map(|(r, force_n)| SimulatedReading { force_n, ..*r }).collect::<Vec<_>>()
+        });
+        Prediction { id: id.into(), load: self.load.iter().flatten().copied().collect(), unload: unload.collect() }
     }
 }
 
-/// Fit the membrane with `terms` from `start`, simulating both phases.
+/// Fit the model with `extensions` from `starts` (none: the starting material), simulating
+/// both phases; friction's factor is fitted on the simulated unloading.
 pub(super) fn fit_model(
     phases: &Phases,
-    terms: Terms,
-    start: StvkNeoHookean,
+    extensions: Extensions,
+    starts: &[StvkNeoHookean],
     lm: &LmSettings,
 ) -> Result<Fitted, ShellFitError> {
-    let fitted = fit_membrane(&phases.load, terms, Some(start), lm)?;
-    let (material, parameter_count) = (fitted.material, fitted.optimizer.params.len());
+    let fitted = fit_membrane(&phases.load, extensions.terms, starts, lm)?;
+    let material = fitted.material;
     let load = phases.load.simulate(&material).ok_or(ShellFitError::Start(material))?;
     let unload = match &phases.unload {
         Some(u) => u.simulate(&material).ok_or(ShellFitError::Start(material))?,
         None => Vec::new(),
     };
-    Ok(Fitted { material, unload_factor: 1.0, parameter_count, load, unload })
+    let hysteresis = match extensions.friction {
+        true => fit_hysteresis(phases, &unload).unwrap_or(Hysteresis::NONE),
+        false => Hysteresis::NONE,
+    };
+    let parameter_count = fitted.optimizer.params.len() + 2 * usize::from(extensions.friction);
+    Ok(Fitted { extensions, material, hysteresis, parameter_count, load, unload })
 }
 
-/// The unloading factor `1 - h` fitting the even unloading targets' forces by least squares.
-fn hysteresis_factor(phases: &Phases, unload: &[Vec<SimulatedReading>]) -> Option<f64> {
+/// The hysteresis fitting the even unloading targets' forces: for each profiled exponent `p`,
+/// `h` by least squares on (6.2)'s normalized force residuals; the `p` of the smallest cost.
+fn fit_hysteresis(phases: &Phases, unload: &[Vec<SimulatedReading>]) -> Option<Hysteresis> {
     let u = phases.unload.as_ref()?;
-    let (mut num, mut den) = (0.0, 0.0);
-    for (d, r) in u.data.iter().zip(unload) {
-        for ((t, reading), fitted) in d.targets.iter().zip(r).zip(&d.fitted) {
-            if *fitted {
-                num += reading.force_n * t.force_n;
-                den += reading.force_n * reading.force_n;
+    let fit_at = |p: f64| {
+        let (mut bb, mut by, mut yy) = (0.0, 0.0, 0.0);
+        for (d, r) in u.data.iter().zip(unload) {
+            let (forces, _) = forces_and_compressions(r);
+            let shape = Hysteresis::shape(p, &forces);
+            for (((t, f), b), fitted) in d.targets.iter().zip(&forces).zip(&shape).zip(&d.fitted) {
+                if *fitted {
+                    // Residual (f - h b - t) / scale: least squares in h.
+                    let (b, y) = (b / d.force_scale, (f - t.force_n) / d.force_scale);
+                    (bb, by, yy) = (bb + b * b, by + b * y, yy + y * y);
+                }
             }
         }
-    }
-    (den > 0.0).then(|| num / den)
+        (bb > 0.0).then(|| (yy - by * by / bb, Hysteresis { h: by / bb, p }))
+    };
+    HYSTERESIS_EXPONENTS.iter().filter_map(|&p| fit_at(p)).min_by(|a, b| a.0.total_cmp(&b.0)).map(|(_, h)| h)
 }
 
 /// The noise level: the pooled RMS of the held-out targets' normalized standard errors.
@@ -219,15 +343,11 @@ pub(super) fn noise_level(phases: &Phases) -> f64 {
     let mut errors = Vec::new();
     for problem in std::iter::once(&phases.load).chain(phases.unload.as_ref()) {
         for d in &problem.data {
-            let forces: Vec<f64> =
-                d.targets.iter().map(|t| t.force_n + t.force_noise_n / (t.readings as f64).sqrt()).collect();
+            let forces: Vec<f64> = d.targets.iter().map(|t| t.force_n + t.force_standard_error_n).collect();
             let compressions: Vec<f64> = d
                 .targets
                 .iter()
-                .map(|t| {
-                    t.compression.unwrap_or(0.0)
-                        + t.compression_noise.unwrap_or(0.0) / (t.readings as f64).sqrt()
-                })
+                .map(|t| t.compression.unwrap_or(0.0) + t.compression_standard_error.unwrap_or(0.0))
                 .collect();
             errors.extend(d.residuals(&forces, &compressions, false));
         }

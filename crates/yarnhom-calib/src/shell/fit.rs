@@ -30,7 +30,7 @@ use super::membrane::{
     Terms, collect_errors, fit_membrane, starting_material,
 };
 use crate::data::set::{Direction, MeasurementSet};
-use crate::data::targets::{Target, TargetPlan, targets};
+use crate::data::targets::{Target, TargetChoice, TargetPlan, targets};
 use crate::experiments::bending_tests::{BendingTarget, BendingTest, BendingTests, BendingTestsError};
 use crate::experiments::swatch::{SimulatedReading, SwatchTest};
 use crate::experiments::uniform::{UniaxialPoint, uniaxial};
@@ -86,6 +86,9 @@ pub struct ShellFit {
     pub settings: ShellFitSettings,
     /// The targets.
     pub targets: Vec<Target>,
+    /// How the targets were chosen, per direction (v2).
+    #[serde(default)]
+    pub target_choices: Vec<TargetChoice>,
     /// The screening (uniform-test) fit.
     pub screening: StvkNeoHookean,
     /// Its errors against the clamped-swatch simulation.
@@ -173,8 +176,9 @@ fn shell_bending(set: &MeasurementSet, membrane: &StvkNeoHookean, lm: &LmSetting
 /// Format tag of [`ShellFit`] files.
 pub const SHELL_FIT_FORMAT: &str = "yarnhom.shell-fit";
 
-/// Layout version of [`ShellFit`] files (`schemas/shell-fit.v1.schema.json`).
-pub const SHELL_FIT_VERSION: u32 = 1;
+/// Layout version of [`ShellFit`] files (`schemas/shell-fit.v2.schema.json`; v2 adds
+/// `target_choices` and the targets' standard errors).
+pub const SHELL_FIT_VERSION: u32 = 2;
 
 /// The JSON Schema of `shell-fit.json`.
 pub fn shell_fit_schema() -> schemars::Schema {
@@ -184,6 +188,21 @@ pub fn shell_fit_schema() -> schemars::Schema {
 impl Report for ShellFit {
     const FORMAT: &'static str = SHELL_FIT_FORMAT;
     const VERSION: u32 = SHELL_FIT_VERSION;
+
+    /// Version 1 was written before the targets said how they were chosen: it reads with no
+    /// `target_choices` and zero standard errors.
+    fn migrate(version: u32, document: serde_json::Value) -> Result<Self, yarnhom_artifacts::Error> {
+        if version != 1 {
+            return Err(yarnhom_artifacts::Error::NoMigration {
+                kind: SHELL_FIT_FORMAT.into(),
+                found: version,
+                supported: SHELL_FIT_VERSION,
+            });
+        }
+        let fit: ShellFit = serde_json::from_value(document)
+            .map_err(|e| yarnhom_artifacts::Error::Decode { what: "shell fit v1", message: e.to_string() })?;
+        Ok(ShellFit { version: SHELL_FIT_VERSION, ..fit })
+    }
 
     /// The material, the errors per direction (fitted and screening), the optimizer and the
     /// mesh check, then the bending fit.
@@ -202,6 +221,7 @@ impl Report for ShellFit {
                 j.onset, j.k_weft, j.k_warp
             ));
         }
+        lines.extend(self.target_choices.iter().map(|c| format!("  targets: {c}")));
         if !self.unconstrained.is_empty() {
             lines.push(format!("  not constrained by the data (held): {}", self.unconstrained.join(", ")));
         }
@@ -294,19 +314,20 @@ fn percent(x: Option<f64>) -> String {
 /// Fit the membrane of `settings.model` to `set`'s stretch tests.
 pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<ShellFit, ShellFitError> {
     let started = Instant::now();
-    let targets = targets(set, &settings.plan)?;
+    let chosen = targets(set, &settings.plan)?;
+    let targets = chosen.targets;
     let problem = Problem::new(DirectionData::group(set, &targets, |_| true), settings.spacing_m);
     let terms = Terms::from(settings.model);
     let start = if terms.jamming {
         // Nested: from the (6.1) fit, with the jamming a thousandth of its starting size.
-        let plain = fit_membrane(&problem, Terms { jamming: false, ..terms }, None, &settings.lm)?.material;
+        let plain = fit_membrane(&problem, Terms { jamming: false, ..terms }, &[], &settings.lm)?.material;
         let seed = starting_material(&problem.data, terms);
-        Some(StvkNeoHookean { jamming: seed.jamming.map(Stiffening::faint), ..plain })
+        vec![StvkNeoHookean { jamming: seed.jamming.map(Stiffening::faint), ..plain }]
     } else {
-        None
+        Vec::new()
     };
     let FittedMembrane { screening, optimizer, material, unconstrained } =
-        fit_membrane(&problem, terms, start, &settings.lm)?;
+        fit_membrane(&problem, terms, &start, &settings.lm)?;
     let screening_simulated = problem.simulate(&screening).ok_or(ShellFitError::Start(screening))?;
     let fitted = problem.simulate(&material).ok_or(ShellFitError::Start(material))?;
     let finer = Problem::new(DirectionData::group(set, &targets, |_| true), 0.5 * settings.spacing_m);
@@ -330,6 +351,7 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         bending: shell_bending(set, &material, &settings.lm),
         simulated: fitted.into_iter().flatten().collect(),
         targets,
+        target_choices: chosen.choices,
     })
 }
 

@@ -164,8 +164,8 @@ pub(crate) struct DirectionData {
     pub specimen: Specimen,
     pub targets: Vec<Target>,
     pub fitted: Vec<bool>,
-    force_scale: f64,
-    compression_scale: Option<f64>,
+    pub force_scale: f64,
+    pub compression_scale: Option<f64>,
 }
 
 impl DirectionData {
@@ -348,15 +348,22 @@ impl Problem {
         r
     }
 
-    /// (6.2) with the uniform test in place of the swatch, from `start`: the encoded parameters.
-    pub fn screen(&self, parameterization: &Parameterization, start: &[f64], lm: &LmSettings) -> Vec<f64> {
+    /// (6.2) with the uniform test in place of the swatch, from `start`, the prior at `prior`:
+    /// the encoded parameters.
+    pub fn screen(
+        &self,
+        parameterization: &Parameterization,
+        start: &[f64],
+        prior: &[f64],
+        lm: &LmSettings,
+    ) -> Vec<f64> {
         let residuals = |p: &[f64]| {
             let m = parameterization.decode(p);
             let r = self.data.iter().flat_map(|d| {
                 let (f, c) = d.uniform(&m);
                 d.residuals(&f, &c, true)
             });
-            Some(Self::with_prior(p, start, r.collect()))
+            Some(Self::with_prior(p, prior, r.collect()))
         };
         let settings = LmSettings { max_iterations: 200, difference_step: 1e-6, ..*lm };
         minimize(residuals, start, &settings).expect("the uniform test is evaluable everywhere").params
@@ -399,36 +406,40 @@ pub(crate) struct FittedMembrane {
     pub unconstrained: Vec<String>,
 }
 
-/// Fit `terms` to the problem's fitted targets: screen on the uniform test from `start`
-/// (default: [`starting_material`]), then refine on the clamped swatches from the better of
-/// the screened point and `start`, with the prior at `start`.
+/// Fit `terms` to the problem's fitted targets: screen on the uniform test from each of
+/// `starts` (none: [`starting_material`]), then refine on the clamped swatches from the best
+/// (lowest swatch cost) of the screened points and the starts, with the prior at the first
+/// start. Several starts let an extension's onset leave a start where it does not act.
 pub(crate) fn fit_membrane(
     problem: &Problem,
     terms: Terms,
-    start: Option<StvkNeoHookean>,
+    starts: &[StvkNeoHookean],
     lm: &LmSettings,
 ) -> Result<FittedMembrane, ShellFitError> {
-    let start = start.unwrap_or_else(|| starting_material(&problem.data, terms));
+    let default = [starting_material(&problem.data, terms)];
+    let starts = if starts.is_empty() { &default[..] } else { starts };
     let parameterization = Parameterization {
         terms,
         fit_shear: problem.data.iter().any(|d| d.direction == Direction::Bias),
-        held: start,
+        held: starts[0],
     };
-    let prior = parameterization.encode(&start);
-    let screened = problem.screen(&parameterization, &prior, lm);
-    let screening = parameterization.decode(&screened);
+    let prior = parameterization.encode(&starts[0]);
+    let encoded: Vec<Vec<f64>> = starts.iter().map(|m| parameterization.encode(m)).collect();
+    let screened: Vec<Vec<f64>> = encoded.iter().map(|p| problem.screen(&parameterization, p, &prior, lm)).collect();
+    let screening = parameterization.decode(&screened[0]);
     let cost = |p: &[f64]| {
         let r = problem.fitted_residuals(&parameterization.decode(p))?;
         Some(r.iter().map(|x| x * x).sum::<f64>())
     };
-    let from = [screened, prior.clone()]
+    let from = screened
         .into_iter()
+        .chain(encoded)
         .filter_map(|p| cost(&p).map(|c| (c, p)))
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .map(|(_, p)| p)
-        .ok_or(ShellFitError::Start(start))?;
+        .ok_or(ShellFitError::Start(starts[0]))?;
     let optimizer =
-        problem.refine(&parameterization, &from, &prior, lm).ok_or(ShellFitError::Start(start))?;
+        problem.refine(&parameterization, &from, &prior, lm).ok_or(ShellFitError::Start(starts[0]))?;
     let material = parameterization.decode(&optimizer.params);
     Ok(FittedMembrane { screening, optimizer, material, unconstrained: parameterization.unconstrained() })
 }
