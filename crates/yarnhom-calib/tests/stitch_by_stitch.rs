@@ -2,10 +2,11 @@
 
 #![cfg(feature = "hdf5")]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
+use hdf5::types::VarLenUnicode;
 use yarnhom_calib::data::set::{Direction, MeasurementSet, Phase, StretchPoint};
-use yarnhom_calib::data::stitch_by_stitch::{SATURATION_FORCE_N, import};
+use yarnhom_calib::data::stitch_by_stitch::{Import, SATURATION_FORCE_N, StretchGauge, import};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic/");
 
@@ -107,7 +108,9 @@ fn every_file_imports_and_round_trips() {
         assert_eq!(imported.videos.len(), 5, "{name}");
         for video in &imported.videos {
             let kept = video.load + video.unload;
-            assert_eq!(kept + video.dropped_saturated + video.dropped_nan, video.frames, "{name}");
+            let dropped = video.dropped_saturated + video.dropped_glitches + video.dropped_nan;
+            assert_eq!(kept + dropped, video.frames, "{name}");
+            assert_eq!(video.gauge, Some(StretchGauge::Pins), "{name}: 7 tracked points");
             assert!(video.load > 1000, "{name}: video{} has {} load points", video.repeat, video.load);
         }
         assert!(name.contains(&set.fabric.pattern), "{name}: pattern {}", set.fabric.pattern);
@@ -158,4 +161,159 @@ fn stretch_starts_at_zero_and_unload_follows_the_peak() {
         let peak = points.iter().filter(|p| p.phase == Phase::Load).map(|p| p.stretch).fold(0.0, f64::max);
         assert!(points.iter().filter(|p| p.phase == Phase::Unload).all(|p| p.stretch <= peak));
     }
+}
+
+#[test]
+fn gauge_glitches_are_dropped_and_counted() {
+    // Per video, the readings the glitch rule drops (the counts of the module docs).
+    let expected = [
+        ("acrylic-garter-x", [1, 0, 0, 0, 0]),
+        ("acrylic-garter-y", [1, 0, 1, 0, 0]),
+        ("acrylic-rib-x", [0, 2, 2, 1, 1]),
+        ("acrylic-rib-y", [1, 0, 0, 0, 0]),
+        ("acrylic-seed-x", [0, 2, 2, 2, 0]),
+        ("acrylic-seed-y", [0, 0, 0, 0, 0]),
+        ("acrylic-stockinette-x", [0, 0, 0, 3, 2]),
+        ("acrylic-stockinette-y", [0, 0, 0, 0, 0]),
+    ];
+    let mut total = 0;
+    for (name, counts) in expected {
+        let imported = import(&file(name), 1).expect("import");
+        let glitches: Vec<usize> = imported.videos.iter().map(|v| v.dropped_glitches).collect();
+        assert_eq!(glitches, counts, "{name}");
+        total += glitches.iter().sum::<usize>();
+        let report = imported.report();
+        let total_line = report.lines().last().expect("a total line");
+        let sum = counts.iter().sum::<usize>();
+        assert!(
+            total_line.starts_with("total: ") && total_line.contains(&format!(" {sum} glitches")),
+            "{name}"
+        );
+    }
+    assert_eq!(total, 21);
+    // Garter y video 3, frame 166: 7.98 N at 7.7 % stretch among readings of 0.97 to 1.04 N.
+    let garter = import(&file("acrylic-garter-y"), 1).expect("import");
+    assert!(
+        !garter.set.stretch.iter().any(|p| p.repeat == Some(3) && p.stretch < 0.1 && p.force_n > 5.0),
+        "the spike is dropped"
+    );
+}
+
+/// Write `data` as the f64 dataset `name` of `shape` in `file`.
+fn write_dataset(file: &hdf5::File, name: &str, shape: &[usize], data: &[f64]) {
+    let dataset = file.new_dataset::<f64>().shape(shape).create(name).expect("create");
+    dataset.write_raw(data).expect("write");
+}
+
+/// Copy the stitch-by-stitch file `source` to `target`, keeping the rows `rows(N)` (in that
+/// order) of each `/videoN/traj` and everything else as it is.
+fn write_copy(source: &Path, target: &Path, rows: impl Fn(u32) -> &'static [usize]) {
+    let from = hdf5::File::open(source).expect("open");
+    let to = hdf5::File::create(target).expect("create");
+    let description: VarLenUnicode = from.attr("description").expect("attr").read_scalar().expect("read");
+    let attribute = to.new_attr::<VarLenUnicode>().create("description").expect("attr");
+    attribute.write_scalar(&description).expect("write");
+    let read = |name: &str| {
+        let dataset = from.dataset(name).expect("dataset");
+        (dataset.read_raw::<f64>().expect("read"), dataset.shape())
+    };
+    let copy = |name: &str| {
+        let (data, shape) = read(name);
+        write_dataset(&to, name, &shape, &data);
+    };
+    copy("clampSize");
+    copy("fabricSize");
+    for repeat in 1..=5 {
+        let group = format!("video{repeat}");
+        to.create_group(&group).expect("group");
+        copy(&format!("{group}/forces"));
+        copy(&format!("{group}/frames"));
+        let (data, shape) = read(&format!("{group}/traj"));
+        let n = shape[2];
+        let rows = rows(repeat);
+        let kept: Vec<f64> =
+            rows.iter().flat_map(|&r| data[r * 2 * n..(r + 1) * 2 * n].iter().copied()).collect();
+        write_dataset(&to, &format!("{group}/traj"), &[rows.len(), 2, n], &kept);
+    }
+}
+
+/// Rows right pin, left pin, bottom clamp and top clamp of the 7-row files.
+const FOUR_OF_SEVEN: [usize; 4] = [0, 1, 5, 6];
+
+/// Rows of the 7-row files as they are.
+const SEVEN: [usize; 7] = [0, 1, 2, 3, 4, 5, 6];
+
+#[test]
+fn four_point_files_read_the_stretch_between_the_clamps() {
+    let source = file("acrylic-rib-x");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let derived = dir.path().join("acrylic-rib-x.h5");
+    write_copy(&source, &derived, |_| &FOUR_OF_SEVEN);
+    let seven = import(&source, 1).expect("import");
+    let four = import(&derived, 1).expect("import");
+
+    // The clamp-distance stretch and the left/right pin compression, per video and frame, from
+    // the 7-row file's clamp and pin rows.
+    let h5 = hdf5::File::open(&source).expect("open");
+    for (repeat, report) in (1..=5).zip(&four.videos) {
+        let traj = h5.dataset(&format!("video{repeat}/traj")).expect("traj");
+        let (data, n) = (traj.read_raw::<f64>().expect("read"), traj.shape()[2]);
+        let distance = |a: usize, b: usize, i: usize| {
+            let at = |row: usize, axis: usize| data[(row * 2 + axis) * n + i];
+            (at(a, 0) - at(b, 0)).hypot(at(a, 1) - at(b, 1))
+        };
+        let stretch: Vec<f64> = (0..n).map(|i| distance(6, 5, i) / distance(6, 5, 0) - 1.0).collect();
+        let compression: Vec<f64> = (0..n).map(|i| 1.0 - distance(1, 0, i) / distance(1, 0, 0)).collect();
+        let forces: Vec<f64> =
+            h5.dataset(&format!("video{repeat}/forces")).expect("forces").read_raw().expect("read");
+        let points = |imported: &Import| -> Vec<StretchPoint> {
+            imported.set.stretch.iter().filter(|p| p.repeat == Some(repeat)).cloned().collect()
+        };
+        let (four_points, seven_points) = (points(&four), points(&seven));
+        // The same frames are kept: saturation and glitches are read off the forces alone.
+        assert_eq!(four_points.len(), seven_points.len(), "video{repeat}");
+        assert!(
+            four_points.iter().zip(&seven_points).any(|(p, q)| (p.stretch - q.stretch).abs() > 0.01),
+            "video{repeat}: the clamps stretch differently from the pins"
+        );
+        let mut frame = 0;
+        for (p, q) in four_points.iter().zip(&seven_points) {
+            assert_eq!((p.force_n, p.compression), (q.force_n, q.compression), "video{repeat}");
+            // Points are in frame order: find this one's frame by its force and compression.
+            while forces[frame] != p.force_n
+                || (compression[frame] - p.compression.expect("measured")).abs() > 1e-12
+            {
+                frame += 1;
+            }
+            assert!((p.stretch - stretch[frame]).abs() < 1e-12, "video{repeat}, frame {frame}");
+            frame += 1;
+        }
+        assert_eq!(report.gauge, Some(StretchGauge::Clamps));
+        let seven_report = &seven.videos[repeat as usize - 1];
+        assert_eq!(report.dropped_glitches, seven_report.dropped_glitches, "video{repeat}");
+        assert_eq!(report.dropped_saturated, seven_report.dropped_saturated, "video{repeat}");
+    }
+    let (swatch, pins) = (&four.set.fabric.swatch, &seven.set.fabric.swatch);
+    assert_eq!(swatch.stretch_gauge_m, Some(swatch.length_m), "the clamp distance is the gauge");
+    assert_eq!((swatch.length_m, swatch.width_m), (pins.length_m, pins.width_m));
+    assert_eq!(swatch.compression_gauge_m, pins.compression_gauge_m);
+    assert!(four.report().contains("stretch from the clamps") && !four.report().contains("pins"));
+    assert!(seven.report().contains("stretch from the top/bottom pins"));
+}
+
+#[test]
+fn a_file_mixing_gauges_is_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let derived = dir.path().join("acrylic-stockinette-y.h5");
+    write_copy(
+        &file("acrylic-stockinette-y"),
+        &derived,
+        |repeat| if repeat == 1 { &SEVEN } else { &FOUR_OF_SEVEN },
+    );
+    let message = import(&derived, 1).expect_err("refused").to_string();
+    assert!(message.contains("acrylic-stockinette-y.h5"), "{message}");
+    assert!(
+        message.contains("video2 reads the stretch between the clamps, video1 between the top/bottom pins"),
+        "{message}"
+    );
 }
