@@ -38,7 +38,7 @@ fn stockinette_set() -> (MeasurementSet, Vec<Target>) {
     let data = format!("{}/../../shared/data/stitch-by-stitch-acrylic", env!("CARGO_MANIFEST_DIR"));
     let files = ["x", "y"].map(|d| format!("{data}/acrylic-stockinette-{d}.h5").into());
     let set = import_fabric(&files, 1).expect("the published files import").set;
-    let targets = targets(&set, &TargetPlan::default()).expect("targets");
+    let targets = targets(&set, &TargetPlan::default()).expect("targets").targets;
     (set, targets)
 }
 

@@ -199,14 +199,17 @@ fn measurement_set(law: &Law, hidden: &[Hidden], sampling: Sampling) -> Measurem
     let mut stretch = Vec::new();
     for direction in Direction::ALL {
         let n = sampling.readings;
-        let mean_force = (1..=n).map(|k| law.clean(direction, S_MAX * k as f64 / n as f64).0).sum::<f64>() / n as f64;
+        let mean_force =
+            (1..=n).map(|k| law.clean(direction, S_MAX * k as f64 / n as f64).0).sum::<f64>() / n as f64;
         let mean_contraction =
             (1..=n).map(|k| law.clean(direction, S_MAX * k as f64 / n as f64).1).sum::<f64>() / n as f64;
         for repeat in 1..=sampling.repeats {
             let scale = 1.0 + 0.01 * (2.0 * rng.uniform() - 1.0);
             for phase in Phase::ALL {
                 let mut levels: Vec<f64> = (1..=n)
-                    .map(|k| if sampling.levels { S_MAX * k as f64 / n as f64 } else { S_MAX * rng.uniform() })
+                    .map(
+                        |k| if sampling.levels { S_MAX * k as f64 / n as f64 } else { S_MAX * rng.uniform() },
+                    )
                     .collect();
                 levels.sort_by(f64::total_cmp);
                 if phase == Phase::Unload {
@@ -231,7 +234,12 @@ fn measurement_set(law: &Law, hidden: &[Hidden], sampling: Sampling) -> Measurem
             name: "independent".into(),
             pattern: "stockinette".into(),
             swatch: Swatch { length_m: 0.10, width_m: WIDTH_M, ..Swatch::default() },
-            yarn: vec![Yarn { material: "wool".into(), linear_density_tex: None, stiffness_n: None, mass_fraction: None }],
+            yarn: vec![Yarn {
+                material: "wool".into(),
+                linear_density_tex: None,
+                stiffness_n: None,
+                mass_fraction: None,
+            }],
         },
         stretch,
         bending: Vec::new(),
@@ -241,22 +249,58 @@ fn measurement_set(law: &Law, hidden: &[Hidden], sampling: Sampling) -> Measurem
 
 /// Laws outside the base family: J-shaped forces, saturating contractions.
 const LAWS: [Law; 3] = [
-    Law { shape: Shape::Polynomial, contraction: Contraction::Green, force_n: [4.0, 2.0, 2.5], nu_weft: 0.35, nu_bias: 0.5 },
-    Law { shape: Shape::Exponential, contraction: Contraction::Saturating, force_n: [3.0, 1.5, 4.0], nu_weft: 0.25, nu_bias: 0.6 },
-    Law { shape: Shape::Power, contraction: Contraction::Saturating, force_n: [4.5, 2.5, 1.5], nu_weft: 0.5, nu_bias: 0.4 },
+    Law {
+        shape: Shape::Polynomial,
+        contraction: Contraction::Green,
+        force_n: [4.0, 2.0, 2.5],
+        nu_weft: 0.35,
+        nu_bias: 0.5,
+    },
+    Law {
+        shape: Shape::Exponential,
+        contraction: Contraction::Saturating,
+        force_n: [3.0, 1.5, 4.0],
+        nu_weft: 0.25,
+        nu_bias: 0.6,
+    },
+    Law {
+        shape: Shape::Power,
+        contraction: Contraction::Saturating,
+        force_n: [4.5, 2.5, 1.5],
+        nu_weft: 0.5,
+        nu_bias: 0.4,
+    },
 ];
 
 /// Clean laws a plain anisotropic membrane can follow (closed-form uniform responses, not the
 /// clamped swatch the diagnosis simulates).
 const CLEAN: [Law; 2] = [
-    Law { shape: Shape::Polynomial, contraction: Contraction::Green, force_n: [4.0, 2.0, 2.5], nu_weft: 0.35, nu_bias: 0.5 },
-    Law { shape: Shape::Green, contraction: Contraction::Green, force_n: [3.0, 1.2, 2.0], nu_weft: 0.3, nu_bias: 0.6 },
+    Law {
+        shape: Shape::Polynomial,
+        contraction: Contraction::Green,
+        force_n: [4.0, 2.0, 2.5],
+        nu_weft: 0.35,
+        nu_bias: 0.5,
+    },
+    Law {
+        shape: Shape::Green,
+        contraction: Contraction::Green,
+        force_n: [3.0, 1.2, 2.0],
+        nu_weft: 0.3,
+        nu_bias: 0.6,
+    },
 ];
 
 fn diagnose_law(law: &Law, hidden: &[Hidden], sampling: Sampling) -> Diagnosis {
     let set = measurement_set(law, hidden, sampling);
     let d = diagnose(&set, &DiagnoseSettings::default()).expect("diagnoses");
-    eprintln!("{:?} {hidden:?} {} readings: {} ({:.1} s)", law.shape, sampling.readings, d.cause.id.as_str(), d.wall_time_s);
+    eprintln!(
+        "{:?} {hidden:?} {} readings: {} ({:.1} s)",
+        law.shape,
+        sampling.readings,
+        d.cause.id.as_str(),
+        d.wall_time_s
+    );
     for line in &d.cause.evidence {
         eprintln!("  {line}");
     }

@@ -6,7 +6,8 @@
 //! `calibrate yarn` on synthetic sets, by removing exactly what each version did not have:
 //! `diagnosis.v1.json` (no bending tests in its set) lacks `extended_material` and `yarn_level`
 //! (and `bending`), `diagnosis.v2.json` (with bending tests) lacks `extended_material` and
-//! `yarn_level`, and `yarn-fit.v1.json` lacks `basis.mechanisms`; each validates against its
+//! `yarn_level` (both lack the v4 fields `causes`, `steps`, `target_choices`,
+//! `unexplained_remainder` and the targets' standard errors), and `yarn-fit.v1.json` lacks `basis.mechanisms`; each validates against its
 //! committed schema.
 
 use std::path::{Path, PathBuf};
@@ -40,6 +41,35 @@ fn upgraded(mut document: Value, version: u32, added: &[(&str, Value)]) -> Value
     document
 }
 
+/// A v1-v3 diagnosis document as version 4 writes it: its cause (a catalog candidate with an
+/// extended model) the one entry of `causes`, no steps, target choices or remainder, and every
+/// target with zero standard errors.
+fn as_v4(document: Value) -> Value {
+    let cause = json!({
+        "id": document["cause"]["id"],
+        "explanation": document["cause"]["explanation"],
+        "step": 1,
+        "model": document["extended"],
+        "gain": document["gain"],
+    });
+    let mut v4 = upgraded(
+        document,
+        4,
+        &[
+            ("/causes", json!([cause])),
+            ("/unexplained_remainder", json!(false)),
+            ("/steps", json!([])),
+            ("/target_choices", json!([])),
+        ],
+    );
+    for list in ["load_targets", "unload_targets"] {
+        for target in v4[list].as_array_mut().expect("targets") {
+            target["force_standard_error_n"] = json!(0.0);
+        }
+    }
+    v4
+}
+
 #[test]
 fn a_v1_diagnosis_reads_without_bending_track_extended_material_and_yarn_level() {
     let v1 = document("diagnosis.v1.json");
@@ -48,10 +78,11 @@ fn a_v1_diagnosis_reads_without_bending_track_extended_material_and_yarn_level()
         assert!(v1.get(absent).is_none(), "{absent}");
     }
     let d: Diagnosis = read_report(&fixture("diagnosis.v1.json")).expect("migrates");
-    assert_eq!((d.version, d.cause.id), (3, CauseId::BiphasicStretch));
+    assert_eq!((d.version, d.cause.id), (4, CauseId::BiphasicStretch));
     assert_eq!((&d.bending, &d.extended_material, &d.yarn_level), (&None, &None, &None));
-    // Everything else is the file's: the migrated report writes the v1 document as version 3.
-    assert_eq!(serde_json::to_value(&d).expect("json"), upgraded(v1, 3, &[]));
+    assert_eq!(d.causes.len(), 1);
+    // Everything else is the file's: the migrated report writes the v1 document as version 4.
+    assert_eq!(serde_json::to_value(&d).expect("json"), as_v4(v1));
 }
 
 #[test]
@@ -60,11 +91,11 @@ fn a_v2_diagnosis_reads_with_its_bending_track_and_without_extended_material_and
     assert_eq!(v2["version"], 2);
     assert!(v2.get("extended_material").is_none() && v2.get("yarn_level").is_none());
     let d: Diagnosis = decode_report(v2.clone()).expect("migrates");
-    assert_eq!(d.version, 3);
+    assert_eq!(d.version, 4);
     let track = d.bending.as_ref().expect("a bending track");
     assert_eq!(track.tests.len(), track.measured.len());
     assert_eq!((&d.extended_material, &d.yarn_level), (&None, &None));
-    assert_eq!(serde_json::to_value(&d).expect("json"), upgraded(v2, 3, &[]));
+    assert_eq!(serde_json::to_value(&d).expect("json"), as_v4(v2));
 }
 
 #[test]
@@ -93,9 +124,9 @@ fn current_reports_round_trip_byte_for_byte() {
 
 #[test]
 fn newer_versions_and_other_formats_are_refused() {
-    let newer = upgraded(document("diagnosis.v2.json"), 4, &[]);
+    let newer = upgraded(document("diagnosis.v2.json"), 5, &[]);
     let error = decode_report::<Diagnosis>(newer).expect_err("newer");
-    assert!(matches!(error, Error::NewerSchema { found: 4, supported: 3, .. }), "{error}");
+    assert!(matches!(error, Error::NewerSchema { found: 5, supported: 4, .. }), "{error}");
     let error = read_report::<YarnFit>(&fixture("diagnosis.v1.json")).expect_err("a diagnosis");
     assert!(matches!(error.root(), Error::WrongKind { expected: "yarnhom.yarn-fit", .. }), "{error}");
     assert!(error.to_string().contains("diagnosis.v1.json"), "errors name the file: {error}");

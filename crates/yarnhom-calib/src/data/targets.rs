@@ -221,7 +221,12 @@ fn direction_targets(
 
 /// `n` targets at even stretches up to `s_max` by local lines, if every window has
 /// [`MIN_WINDOW_READINGS`] readings.
-fn window_targets(direction: Direction, readings: &[&StretchPoint], s_max: f64, n: usize) -> Option<Vec<Target>> {
+fn window_targets(
+    direction: Direction,
+    readings: &[&StretchPoint],
+    s_max: f64,
+    n: usize,
+) -> Option<Vec<Target>> {
     let spacing = s_max / n as f64;
     (1..=n)
         .map(|i| {
@@ -237,7 +242,8 @@ fn window_targets(direction: Direction, readings: &[&StretchPoint], s_max: f64, 
 fn window_target(direction: Direction, near: &[&StretchPoint], stretch: f64) -> Target {
     let count = near.len() as f64;
     let (force_n, force_noise_n) = local_line(near.iter().map(|p| (p.stretch, p.force_n)), stretch);
-    let with_compression: Vec<&StretchPoint> = near.iter().copied().filter(|p| p.compression.is_some()).collect();
+    let with_compression: Vec<&StretchPoint> =
+        near.iter().copied().filter(|p| p.compression.is_some()).collect();
     let compression_of = |p: &StretchPoint| p.compression.unwrap_or(0.0);
     let compression = (with_compression.len() >= MIN_WINDOW_READINGS)
         .then(|| local_line(with_compression.iter().map(|p| (p.stretch, compression_of(p))), stretch));
@@ -294,8 +300,8 @@ fn group_targets(direction: Direction, readings: &[&StretchPoint], n: usize) -> 
             let count = group.len() as f64;
             let mean = |f: &dyn Fn(&StretchPoint) -> f64| group.iter().map(|p| f(p)).sum::<f64>() / count;
             let compressions: Vec<f64> = group.iter().filter_map(|p| p.compression).collect();
-            let compression = (compressions.len() == group.len())
-                .then(|| compressions.iter().sum::<f64>() / count);
+            let compression =
+                (compressions.len() == group.len()).then(|| compressions.iter().sum::<f64>() / count);
             Target {
                 direction,
                 stretch: mean(&|p| p.stretch),
@@ -443,8 +449,9 @@ mod tests {
                 point(Direction::Weft, s, 10.0 * s + if k % 2 == 0 { 0.02 } else { -0.02 }, 0.2 * s)
             })
             .collect();
-        let chosen = targets(&set(points.clone()), &TargetPlan { per_direction: 10, ..TargetPlan::default() })
-            .expect("targets");
+        let chosen =
+            targets(&set(points.clone()), &TargetPlan { per_direction: 10, ..TargetPlan::default() })
+                .expect("targets");
         assert_eq!(chosen.choices[0].method, TargetMethod::Groups);
         assert_eq!(chosen.targets.len(), 10);
         for (t, p) in chosen.targets.iter().zip(&points) {
@@ -455,10 +462,13 @@ mod tests {
         let noise = chosen.targets[0].force_noise_n;
         assert!((noise - 0.04 / 1.5f64.sqrt()).abs() < 1e-12, "{noise}");
         // Five targets from ten readings: pairs.
-        let five = targets(&set(points), &TargetPlan { per_direction: 5, ..TargetPlan::default() }).expect("five");
+        let five =
+            targets(&set(points), &TargetPlan { per_direction: 5, ..TargetPlan::default() }).expect("five");
         assert_eq!(five.targets.len(), 5);
         assert!(five.targets.iter().all(|t| t.readings == 2));
-        assert!(five.choices[0].to_string().contains("5 targets up to stretch 0.4000 from 10 readings (means of"));
+        assert!(
+            five.choices[0].to_string().contains("5 targets up to stretch 0.4000 from 10 readings (means of")
+        );
     }
 
     #[test]
@@ -489,7 +499,8 @@ mod tests {
             point(Direction::Weft, 0.2, 2.0, 0.0),
             point(Direction::Weft, 0.3, 3.0, 0.0),
         ];
-        let error = targets(&set(sparse), &TargetPlan::default()).expect_err("three readings cannot be split");
+        let error =
+            targets(&set(sparse), &TargetPlan::default()).expect_err("three readings cannot be split");
         assert!(
             matches!(error, TargetError::TooFew { direction: Direction::Weft, readings: 3, .. }),
             "{error}"

@@ -5,38 +5,43 @@
 //! The screening runs at the shell level, on the clamped swatches of the stretch tests
 //! ([`crate::shell::membrane`]), in stages ([`diagnose`]):
 //!
-//! 1. Targets and split ([`stretch`]): `n` stretches per direction (default 10) from the
-//!    loading readings; the even ones are fitted, the odd ones held out. Unloading readings,
-//!    where the set has enough, give unloading targets split the same way.
+//! 1. Targets and split ([`stretch`]): up to `n` stretches per direction (default 10) chosen
+//!    from the loading readings the set has ([`crate::data::targets`]: local lines over even
+//!    windows, or means of consecutive groups where readings are few); the even ones are
+//!    fitted, the odd ones held out. Unloading readings, where the set has enough, give
+//!    unloading targets split the same way.
 //! 2. Base fit: plain anisotropic StVK (no area terms, no stiffening; unloading predicted as
 //!    loading), fitted by simulation in the loop.
-//! 3. Candidate fits, each a nested extension of the base, fitted from it:
-//!    `area-preservation` (the Neo-Hookean area terms of (6.1)), `biphasic-stretch`
-//!    ([`yarnhom_shell::Stiffening`]: stiffening past an onset strain), `friction-hysteresis`
-//!    (unloading force `(1 - h)` times the loading force at the same stretch, `h` fitted on the
-//!    even unloading targets), `two-phase-contact` (jamming,
+//! 3. Stepwise explanation of the stretch track: every remaining candidate is fitted on top of
+//!    the model so far, from several starts ([`stretch::fit_candidate`]): `area-preservation`
+//!    (the Neo-Hookean area terms of (6.1)), `biphasic-stretch` ([`yarnhom_shell::Stiffening`]:
+//!    stiffening past an onset strain), `friction-hysteresis` (the unloading force
+//!    `F - h F_ref (F / F_ref)^p`, `p` profiled, `h` fitted on the even unloading targets),
+//!    `two-phase-contact` (jamming,
 //!    [`StvkNeoHookean::jamming`](yarnhom_shell::StvkNeoHookean::jamming): the compression
 //!    across the pull stiffens past an onset, the shell-level trace of the soft then hard yarn
-//!    contact of (6.7), as stiffening is of the biphasic yarn stretch (6.5)). The bending causes
-//!    form a second track ([`bending`]) on the set's bending tests (the even readings of each
-//!    test, direction and face fitted, the odd held out): base isotropic flat bending (one
-//!    `k_θ`), `anisotropic-bending` (`k_θ` per direction) and `rest-curvature` (one `k_θ` and a
-//!    rest curvature per direction, seen only by the cantilever tests on both faces); without
-//!    the tests (or the areal density) they are not testable, with the reason.
-//! 4. Choice: the [`DecisionRule`] (held-out error against the track's
-//!    base and noise, the Akaike criterion, the share of the discrepancy fixed; `none` and
-//!    `unexplained` when no candidate passes) names the cause.
-//! 5. Evidence: the numbers behind the choice, worded from the same rule.
+//!    contact of (6.7)). Each is judged by the [`DecisionRule`] on the held-out targets and on
+//!    its own signature ([`signature`]); the passing one with the lowest held-out error is
+//!    added, and the others are fitted again on top of it, until none passes or the held-out
+//!    error is at the noise. The bending causes form a second track ([`bending`]) on the set's
+//!    bending tests (the even readings of each test, direction and face fitted, the odd held
+//!    out): base isotropic flat bending (one `k_θ`), `anisotropic-bending` (`k_θ` per
+//!    direction) and `rest-curvature` (one `k_θ` and a rest curvature per direction, seen only
+//!    by the cantilever tests on both faces), alternatives in one step; without the tests (or
+//!    the areal density) they are not testable, with the reason.
+//! 4. Causes: every confirmed cause in order of relative held-out gain (`causes`, the first is
+//!    `cause`), else `none` or `unexplained` by the rule; an unexplained remainder is flagged.
+//! 5. Evidence: every step's numbers, worded from the same rule.
 //! 6. Confirmation (separate, [`confirm`], run by `calibrate diagnose` unless `--budget
-//!    quick`): a cause with a mechanism in the yarn model is confirmed on the periodic tile by
-//!    nested yarn-level fits to the extended shell's uniform targets
-//!    ([`Diagnosis::extended_material`]); the result
-//!    goes to [`Diagnosis::yarn_level`].
+//!    quick`): the first cause, if it has a mechanism in the yarn model, is confirmed on the
+//!    periodic tile by nested yarn-level fits to the extended shell's uniform targets
+//!    ([`Diagnosis::extended_material`]); the result goes to [`Diagnosis::yarn_level`].
 //!
 //! Errors are RMS values of the normalized residuals of (6.2) (force over the direction's mean
 //! force, compression over its mean compression), pooled over the fitted or the held-out
 //! targets; the noise is the pooled standard error of the targets (their readings' scatter
-//! about the local line over the square root of their count). On the bending track the errors
+//! about the local line over the square root of their count, or the spread between repeats
+//! over the square root of the repeats where larger). On the bending track the errors
 //! are those of the bending tests ([`crate::experiments::bending_tests`]: each reading over its
 //! group's mean), and the noise is the readings' scatter about a cubic in the abscissa fitted
 //! to each test group, pooled over the residual degrees of freedom (an upper bound where a
@@ -58,7 +63,8 @@ use std::time::Instant;
 
 use bending::bending_track;
 use report::{
-    Cause, ConfirmedCause, DIAGNOSIS_FORMAT, DIAGNOSIS_VERSION, Diagnosis, Gain, ModelResult, SignatureScore, Step,
+    Cause, ConfirmedCause, DIAGNOSIS_FORMAT, DIAGNOSIS_VERSION, Diagnosis, Gain, ModelResult, SignatureScore,
+    Step,
 };
 use rule::DecisionRule;
 use settings::DiagnoseSettings;
@@ -90,7 +96,10 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
     let final_stretch = stretch.causes.last().map_or(&base, |c| &c.model);
     let final_bending = bend.cause.as_ref().map(|c| &c.model).or(bending_track.as_ref().map(|t| &t.base));
     let remainder = !rule.within_noise(final_stretch.scores().1, noise)
-        || bending_track.as_ref().zip(final_bending).is_some_and(|(t, m)| !rule.within_noise(m.scores().1, t.noise));
+        || bending_track
+            .as_ref()
+            .zip(final_bending)
+            .is_some_and(|(t, m)| !rule.within_noise(m.scores().1, t.noise));
     let id = match causes.first() {
         Some(c) => c.id,
         None if remainder => CauseId::Unexplained,
@@ -103,14 +112,17 @@ pub fn diagnose(set: &MeasurementSet, settings: &DiagnoseSettings) -> Result<Dia
     let (extended, gain) = match (stretch.causes.last(), &bend.cause) {
         (Some(c), _) => (Some(c.model.clone()), Gain { heldout_error_before: base.scores().1, ..c.gain }),
         (None, Some(c)) => (Some(c.model.clone()), c.gain),
-        (None, None) => (None, Gain { heldout_error_before: base.scores().1, heldout_error_after: base.scores().1 }),
+        (None, None) => {
+            (None, Gain { heldout_error_before: base.scores().1, heldout_error_after: base.scores().1 })
+        }
     };
     if let (Some(t), Some((cid, f))) = (bending_track.as_mut(), &bend.fit) {
         t.predictions.push((cid.as_str().into(), f.simulated.clone()));
     }
     let final_fit = stretch.causes.last().map(|c| (&c.model.id, &stretch.fit));
-    let predictions =
-        std::iter::once(base_fit.prediction("base")).chain(final_fit.map(|(id, f)| f.prediction(id))).collect();
+    let predictions = std::iter::once(base_fit.prediction("base"))
+        .chain(final_fit.map(|(id, f)| f.prediction(id)))
+        .collect();
     let mut steps = stretch.steps;
     steps.extend(bend.step);
     Ok(Diagnosis {
@@ -180,7 +192,12 @@ fn explain_stretch(
     rule: &DecisionRule,
     lm: &LmSettings,
 ) -> StretchExplanation {
-    let mut out = StretchExplanation { steps: Vec::new(), causes: Vec::new(), evidence: Vec::new(), fit: base_fit.clone() };
+    let mut out = StretchExplanation {
+        steps: Vec::new(),
+        causes: Vec::new(),
+        evidence: Vec::new(),
+        fit: base_fit.clone(),
+    };
     let mut model = base.clone();
     for step in 1..=STRETCH_CAUSES.len() {
         if step > 1 && rule.within_noise(model.scores().1, noise) {
@@ -189,11 +206,14 @@ fn explain_stretch(
         let remaining = STRETCH_CAUSES.into_iter().filter(|id| out.causes.iter().all(|c| c.id != *id));
         let fits: Vec<(CauseId, Option<Fitted>)> =
             remaining.map(|id| (id, fit_candidate(id, phases, &out.fit, lm))).collect();
-        let results: Vec<ModelResult> = fits.iter().map(|(id, f)| candidate_result(*id, f.as_ref(), phases, &out.fit)).collect();
+        let results: Vec<ModelResult> =
+            fits.iter().map(|(id, f)| candidate_result(*id, f.as_ref(), phases, &out.fit)).collect();
         out.evidence.extend(rule.step_evidence(step, &model, noise, &results));
         let added = rule.best(&model, noise, &results).map(|c| id_of(&c.id));
         out.steps.push(Step { model: model.id.clone(), candidates: results, added });
-        let Some((id, Some(fit))) = added.and_then(|a| fits.into_iter().find(|(id, _)| *id == a)) else { break };
+        let Some((id, Some(fit))) = added.and_then(|a| fits.into_iter().find(|(id, _)| *id == a)) else {
+            break;
+        };
         let name = if step == 1 { id.as_str().to_string() } else { format!("{}+{}", model.id, id.as_str()) };
         let result = fit.result(&name, phases, None);
         out.evidence.push(format!("step {step}: added {}: the model is now {name}", id.as_str()));
@@ -214,11 +234,16 @@ fn explain_stretch(
 /// with the reason.
 fn candidate_result(id: CauseId, fit: Option<&Fitted>, phases: &Phases, model: &Fitted) -> ModelResult {
     match fit {
-        Some(f) => ModelResult { signature: signature::score(id, phases, model, f), ..f.result(id.as_str(), phases, None) },
+        Some(f) => ModelResult {
+            signature: signature::score(id, phases, model, f),
+            ..f.result(id.as_str(), phases, None)
+        },
         None if id == CauseId::FrictionHysteresis => {
             ModelResult::untestable(id, phases.unload_note().unwrap_or("no unloading data"))
         }
-        None => ModelResult::untestable(id, "the extended swatch has no equilibrium from the model fitted so far"),
+        None => {
+            ModelResult::untestable(id, "the extended swatch has no equilibrium from the model fitted so far")
+        }
     }
 }
 
@@ -258,7 +283,11 @@ fn explain_bending(
         results.push(result);
     }
     let Some((base, noise)) = track else {
-        let step = (!results.is_empty()).then(|| Step { model: BENDING_BASE.into(), candidates: results, added: None });
+        let step = (!results.is_empty()).then(|| Step {
+            model: BENDING_BASE.into(),
+            candidates: results,
+            added: None,
+        });
         return BendingExplanation { step, cause: None, fit: None, evidence: Vec::new() };
     };
     let evidence = rule.step_evidence(1, base, noise, &results);
@@ -272,7 +301,12 @@ fn explain_bending(
         model,
     });
     let fit = added.and_then(|a| fits.into_iter().find(|(id, _)| *id == a));
-    BendingExplanation { step: Some(Step { model: BENDING_BASE.into(), candidates: results, added }), cause, fit, evidence }
+    BendingExplanation {
+        step: Some(Step { model: BENDING_BASE.into(), candidates: results, added }),
+        cause,
+        fit,
+        evidence,
+    }
 }
 
 /// The bases' lines of the evidence.

@@ -47,7 +47,13 @@ pub struct DecisionRule {
 impl Default for DecisionRule {
     /// The rule of `calibrate diagnose`.
     fn default() -> Self {
-        Self { noise_margin: 2.0, criterion_drop: 4.0, signature_left: 0.5, none_noise_multiple: 3.0, none_floor: 0.03 }
+        Self {
+            noise_margin: 2.0,
+            criterion_drop: 4.0,
+            signature_left: 0.5,
+            none_noise_multiple: 3.0,
+            none_floor: 0.03,
+        }
     }
 }
 
@@ -92,14 +98,17 @@ impl DecisionRule {
     pub(super) fn is_significant(&self, model: &ModelResult, noise: f64, c: &ModelResult) -> bool {
         let (_, heldout, criterion) = c.scores();
         let (_, model_heldout, model_criterion) = model.scores();
-        heldout < model_heldout - self.noise_margin * noise && criterion < model_criterion - self.criterion_drop
+        heldout < model_heldout - self.noise_margin * noise
+            && criterion < model_criterion - self.criterion_drop
     }
 
     /// Whether `c` explains its signature.
     pub(super) fn explains_signature(&self, c: &ModelResult) -> bool {
         c.signature.as_ref().is_some_and(|s| {
             let margin = self.noise_margin * s.noise;
-            s.before > s.noise + margin && s.after < s.before - margin && self.signature_excess_left(s) <= self.signature_left
+            s.before > s.noise + margin
+                && s.after < s.before - margin
+                && self.signature_excess_left(s) <= self.signature_left
         })
     }
 
@@ -115,7 +124,12 @@ impl DecisionRule {
 
     /// The candidate to add among `candidates` (tested against `model` at `noise`): the passing
     /// one with the lowest held-out error.
-    pub(super) fn best<'a>(&self, model: &ModelResult, noise: f64, candidates: &'a [ModelResult]) -> Option<&'a ModelResult> {
+    pub(super) fn best<'a>(
+        &self,
+        model: &ModelResult,
+        noise: f64,
+        candidates: &'a [ModelResult],
+    ) -> Option<&'a ModelResult> {
         candidates
             .iter()
             .filter(|c| self.passes(model, noise, c))
@@ -128,7 +142,13 @@ impl DecisionRule {
     }
 
     /// One evidence line per tested candidate of a step against `model`.
-    pub(super) fn step_evidence(&self, step: usize, model: &ModelResult, noise: f64, candidates: &[ModelResult]) -> Vec<String> {
+    pub(super) fn step_evidence(
+        &self,
+        step: usize,
+        model: &ModelResult,
+        noise: f64,
+        candidates: &[ModelResult],
+    ) -> Vec<String> {
         let (_, model_heldout, model_criterion) = model.scores();
         candidates
             .iter()
@@ -172,7 +192,9 @@ impl DecisionRule {
                 fraction_in_words(self.signature_left)
             ),
             CauseId::Unexplained => {
-                format!("no candidate passes the tests, and a base's held-out error exceeds {within} of its track")
+                format!(
+                    "no candidate passes the tests, and a base's held-out error exceeds {within} of its track"
+                )
             }
             _ => format!("confirmed: {}", cause.as_str()),
         }
@@ -182,7 +204,10 @@ impl DecisionRule {
     pub(super) fn remainder(&self, heldout: f64, noise: f64) -> String {
         let limit = (self.none_noise_multiple * noise).max(self.none_floor);
         if heldout <= limit {
-            format!("the confirmed causes leave a held-out error of {heldout:.4}, within max({} x noise, {}) = {limit:.4}", self.none_noise_multiple, self.none_floor)
+            format!(
+                "the confirmed causes leave a held-out error of {heldout:.4}, within max({} x noise, {}) = {limit:.4}",
+                self.none_noise_multiple, self.none_floor
+            )
         } else {
             format!(
                 "the confirmed causes leave a held-out error of {heldout:.4}, above max({} x noise, {}) = {limit:.4}: the rest is unexplained by the catalog",
@@ -206,7 +231,10 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../docs/methods.md");
         let doc = std::fs::read_to_string(path).expect("docs/methods.md");
         let table = DecisionRule::default().markdown();
-        assert!(doc.contains(&table), "docs/methods.md must hold DecisionRule::default().markdown():\n{table}");
+        assert!(
+            doc.contains(&table),
+            "docs/methods.md must hold DecisionRule::default().markdown():\n{table}"
+        );
     }
 
     fn model(id: &str, heldout: f64, criterion: f64, signature: Option<(f64, f64, f64)>) -> ModelResult {

@@ -57,10 +57,7 @@ fn error(id: CauseId, phases: &Phases, model: &Fitted) -> Option<(f64, f64)> {
         _ => return None,
     };
     (!components.is_empty()).then(|| {
-        (
-            root_mean_square(components.iter().map(|c| c.0)),
-            root_mean_square(components.iter().map(|c| c.1)),
-        )
+        (root_mean_square(components.iter().map(|c| c.0)), root_mean_square(components.iter().map(|c| c.1)))
     })
 }
 
@@ -161,7 +158,11 @@ fn paired_differences(phases: &Phases, model: &Fitted) -> Option<Vec<Component>>
 /// The loading force at `stretch`, linear between the two targets around it (or the nearest
 /// two), and the larger of their standard errors.
 fn interpolate_force(targets: &[Target], stretch: f64) -> (f64, f64) {
-    let k = targets.iter().position(|t| t.stretch >= stretch).unwrap_or(targets.len() - 1).clamp(1, targets.len() - 1);
+    let k = targets
+        .iter()
+        .position(|t| t.stretch >= stretch)
+        .unwrap_or(targets.len() - 1)
+        .clamp(1, targets.len() - 1);
     let (a, b) = (&targets[k - 1], &targets[k]);
     let w = (stretch - a.stretch) / (b.stretch - a.stretch);
     ((1.0 - w) * a.force_n + w * b.force_n, a.force_standard_error_n.max(b.force_standard_error_n))

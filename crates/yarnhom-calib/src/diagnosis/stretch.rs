@@ -41,10 +41,11 @@ impl Phases {
         };
         let load = targets(set, &plan)?;
         let even = |k: usize| k.is_multiple_of(2);
-        let (unload_targets, unload_note, unload_choices) = match targets(set, &TargetPlan { phase: Phase::Unload, ..plan }) {
-            Ok(t) => (Some(t.targets), None, t.choices),
-            Err(e) => (None, Some(format!("no unloading targets: {e}")), Vec::new()),
-        };
+        let (unload_targets, unload_note, unload_choices) =
+            match targets(set, &TargetPlan { phase: Phase::Unload, ..plan }) {
+                Ok(t) => (Some(t.targets), None, t.choices),
+                Err(e) => (None, Some(format!("no unloading targets: {e}")), Vec::new()),
+            };
         let load_problem = Problem::new(DirectionData::group(set, &load.targets, even), settings.spacing_m);
         let unload = unload_targets
             .as_ref()
@@ -95,8 +96,12 @@ impl Extensions {
 }
 
 /// The stretch-track causes, in catalog order.
-pub(super) const STRETCH_CAUSES: [CauseId; 4] =
-    [CauseId::AreaPreservation, CauseId::BiphasicStretch, CauseId::FrictionHysteresis, CauseId::TwoPhaseContact];
+pub(super) const STRETCH_CAUSES: [CauseId; 4] = [
+    CauseId::AreaPreservation,
+    CauseId::BiphasicStretch,
+    CauseId::FrictionHysteresis,
+    CauseId::TwoPhaseContact,
+];
 
 /// The base of the stretch track: plain anisotropic StVK from its starting material.
 pub(super) fn fit_base(phases: &Phases, lm: &LmSettings) -> Result<Fitted, ShellFitError> {
@@ -115,7 +120,12 @@ pub(super) fn fit_candidate(id: CauseId, phases: &Phases, model: &Fitted, lm: &L
     }
     if id == CauseId::FrictionHysteresis {
         let hysteresis = fit_hysteresis(phases, &model.unload)?;
-        return Some(Fitted { extensions, hysteresis, parameter_count: model.parameter_count + 2, ..model.clone() });
+        return Some(Fitted {
+            extensions,
+            hysteresis,
+            parameter_count: model.parameter_count + 2,
+            ..model.clone()
+        });
     }
     fit_model(phases, extensions, &candidate_starts(id, phases, &model.material), lm).ok()
 }
@@ -141,14 +151,19 @@ fn candidate_starts(id: CauseId, phases: &Phases, material: &StvkNeoHookean) -> 
         sizes
             .iter()
             .flat_map(|size| {
-                onsets.map(|f| Stiffening { k_weft: size * k.0, k_warp: size * k.1, onset: (f * largest).max(1e-3) })
+                onsets.map(|f| Stiffening {
+                    k_weft: size * k.0,
+                    k_warp: size * k.1,
+                    onset: (f * largest).max(1e-3),
+                })
             })
             .collect()
     };
     let full: Vec<StvkNeoHookean> = match id {
-        CauseId::AreaPreservation => {
-            [0.05, 0.3, 1.0].iter().map(|f| StvkNeoHookean { k_n1: f * mean, k_n2: f * mean, ..nested }).collect()
-        }
+        CauseId::AreaPreservation => [0.05, 0.3, 1.0]
+            .iter()
+            .map(|f| StvkNeoHookean { k_n1: f * mean, k_n2: f * mean, ..nested })
+            .collect(),
         CauseId::BiphasicStretch => {
             let largest = seed.stiffening.map_or(0.0, |b| 4.0 * b.onset);
             grid([0.2, 0.45, 0.7], [1.0, 5.0], largest, (material.k_xx, material.k_yy))
@@ -287,9 +302,17 @@ impl Fitted {
         let unload = self.unload.iter().flat_map(|readings| {
             let (forces, _) = forces_and_compressions(readings);
             let unloading = self.hysteresis.unloading(&forces);
-            readings.iter().zip(unloading).map(|(r, force_n)| SimulatedReading { force_n, ..*r }).collect::<Vec<_>>()
+            readings
+                .iter()
+                .zip(unloading)
+                .map(|(r, force_n)| SimulatedReading { force_n, ..*r })
+                .collect::<Vec<_>>()
         });
-        Prediction { id: id.into(), load: self.load.iter().flatten().copied().collect(), unload: unload.collect() }
+        Prediction {
+            id: id.into(),
+            load: self.load.iter().flatten().copied().collect(),
+            unload: unload.collect(),
+        }
     }
 }
 

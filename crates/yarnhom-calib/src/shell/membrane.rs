@@ -425,7 +425,8 @@ pub(crate) fn fit_membrane(
     };
     let prior = parameterization.encode(&starts[0]);
     let encoded: Vec<Vec<f64>> = starts.iter().map(|m| parameterization.encode(m)).collect();
-    let screened: Vec<Vec<f64>> = encoded.iter().map(|p| problem.screen(&parameterization, p, &prior, lm)).collect();
+    let screened: Vec<Vec<f64>> =
+        encoded.iter().map(|p| problem.screen(&parameterization, p, &prior, lm)).collect();
     let screening = parameterization.decode(&screened[0]);
     let cost = |p: &[f64]| {
         let r = problem.fitted_residuals(&parameterization.decode(p))?;
