@@ -1,5 +1,6 @@
 #![doc = include_str!("../README.md")]
 
+pub mod auto_model;
 pub mod cause;
 pub mod data;
 pub mod diagnosis;

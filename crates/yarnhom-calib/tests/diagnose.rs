@@ -1,17 +1,22 @@
 //! Hidden-effect tests: a synthetic set is made from a ground truth with one effect hidden in
 //! it (or none), and the diagnosis, told nothing about it, must name it.
 
+use yarnhom_artifacts::report::Report;
+use yarnhom_calib::auto_model::fit_shell;
 use yarnhom_calib::cause::CauseId;
+use yarnhom_calib::data::set::MeasurementSet;
 use yarnhom_calib::diagnosis::diagnose;
 use yarnhom_calib::diagnosis::report::Diagnosis;
 use yarnhom_calib::diagnosis::settings::DiagnoseSettings;
 use yarnhom_calib::experiments::synth::{BendingPlan, HiddenEffect, SynthPlan, ground_truth, synthesize};
+use yarnhom_calib::shell::fit::ShellFitSettings;
+use yarnhom_calib::shell::membrane::MembraneModel;
 
 /// Relative noise: force and compression noise as this fraction of their mean clean values.
 const NOISE: f64 = 0.02;
 
-/// Diagnose a set made from `effect` hidden at `strength`, with bending tests if `bending`.
-fn hidden(effect: HiddenEffect, strength: f64, seed: u64, bending: bool) -> Diagnosis {
+/// A set made from `effect` hidden at `strength`, with bending tests if `bending`.
+fn hidden_set(effect: HiddenEffect, strength: f64, seed: u64, bending: bool) -> MeasurementSet {
     let truth = ground_truth(effect, strength);
     let mut clean_plan = SynthPlan {
         readings: 120,
@@ -31,7 +36,12 @@ fn hidden(effect: HiddenEffect, strength: f64, seed: u64, bending: bool) -> Diag
         seed,
         ..clean_plan
     };
-    let set = synthesize(&truth, &plan).expect("simulates");
+    synthesize(&truth, &plan).expect("simulates")
+}
+
+/// Diagnose a set made from `effect` hidden at `strength`, with bending tests if `bending`.
+fn hidden(effect: HiddenEffect, strength: f64, seed: u64, bending: bool) -> Diagnosis {
+    let set = hidden_set(effect, strength, seed, bending);
     let settings = DiagnoseSettings { spacing_m: 0.01, ..DiagnoseSettings::default() };
     let d = diagnose(&set, &settings).expect("diagnoses");
     eprintln!("{effect:?} x{strength}: {} ({:.1} s)", d.cause.id.as_str(), d.wall_time_s);
@@ -122,4 +132,19 @@ fn hidden_hysteresis_is_found_on_the_unloading_readings() {
     let h =
         d.extended.as_ref().expect("extended").params.iter().find(|p| p.0 == "hysteresis_h").expect("h").1;
     assert!(h > 0.0, "unloading below loading: h = {h}");
+}
+
+#[test]
+fn the_auto_model_fits_the_stiffening_the_diagnosis_confirms() {
+    let set = hidden_set(HiddenEffect::BiphasicStretch, 1.0, 13, false);
+    let settings = ShellFitSettings { model: MembraneModel::Auto, spacing_m: 0.01, ..ShellFitSettings::default() };
+    let auto = fit_shell(&set, &settings).expect("fits");
+    let chosen = auto.auto.as_ref().expect("the choice is recorded");
+    assert!(chosen.fitted.contains(&CauseId::BiphasicStretch), "{chosen:?}");
+    assert!(auto.material.stiffening.is_some(), "{:?}", auto.material);
+    let plain = ShellFitSettings { model: MembraneModel::StvkNeoHookean, ..settings };
+    let plain = fit_shell(&set, &plain).expect("fits");
+    assert!(plain.auto.is_none());
+    assert!(auto.errors.force < 0.5 * plain.errors.force, "{:?} vs {:?}", auto.errors, plain.errors);
+    assert!(auto.summary().contains("auto: the diagnosis confirmed biphasic-stretch"), "{}", auto.summary());
 }

@@ -13,7 +13,8 @@ use yarnhom_calib::diagnosis::{confirm, diagnose};
 use yarnhom_calib::experiments::pear_loop::PearLoopTest;
 use yarnhom_calib::experiments::strip::hinge_bending;
 use yarnhom_calib::experiments::synth::{HiddenEffect, SynthRequest, ground_truth};
-use yarnhom_calib::shell::fit::{ShellFit, ShellFitSettings, fit_shell};
+use yarnhom_calib::auto_model::fit_shell;
+use yarnhom_calib::shell::fit::{ShellFit, ShellFitSettings};
 use yarnhom_calib::shell::membrane::MembraneModel;
 
 use yarnhom_calib::figures;

@@ -28,9 +28,9 @@
 //!   local lines at `s_i` over the square root of the repeats, whichever is larger (repeats of
 //!   one swatch differ from each other more than each curve is noisy);
 //! - groups: the direction's reading scatter (each reading against the line through its two
-//!   neighbours in stretch, within its repeat: `d = y - ŷ`, `σ² = mean(d²) / (1 + w₁² + w₂²)`
-//!   with `w` the interpolation weights; an upper bound where the curve bends) over the square
-//!   root of the group's size.
+//!   neighbours in stretch, within its repeat: `d = (y - ŷ) / √(1 + w₁² + w₂²)` with `w` the
+//!   interpolation weights, and `σ = median |d| / 0.6745`, robust to a kink or a glitch; an
+//!   upper bound where the curve bends) over the square root of the group's size.
 
 use std::fmt;
 
@@ -318,12 +318,14 @@ fn group_targets(direction: Direction, readings: &[&StretchPoint], n: usize) -> 
 }
 
 /// The readings' scatter about the line through their two neighbours in stretch, within each
-/// repeat (see the module docs); `None` without a value on three readings of one repeat.
+/// repeat (see the module docs), from the median of the scaled deviations (a kink or a
+/// glitch moves one or two of them, not the median); `None` without a value on three readings
+/// of one repeat.
 fn neighbour_scatter(sorted: &[&StretchPoint], value: impl Fn(&StretchPoint) -> Option<f64>) -> Option<f64> {
     let mut repeats: Vec<Option<u32>> = sorted.iter().map(|p| p.repeat).collect();
     repeats.sort_unstable();
     repeats.dedup();
-    let (mut sum, mut count) = (0.0, 0usize);
+    let mut deviations = Vec::new();
     for r in repeats {
         let mine: Vec<(f64, f64)> =
             sorted.iter().filter(|p| p.repeat == r).filter_map(|p| Some((p.stretch, value(p)?))).collect();
@@ -334,11 +336,17 @@ fn neighbour_scatter(sorted: &[&StretchPoint], value: impl Fn(&StretchPoint) -> 
             }
             let t = (x - x0) / (x1 - x0);
             let d = y - ((1.0 - t) * y0 + t * y1);
-            sum += d * d / (1.0 + t * t + (1.0 - t) * (1.0 - t));
-            count += 1;
+            deviations.push(d.abs() / (1.0 + t * t + (1.0 - t) * (1.0 - t)).sqrt());
         }
     }
-    (count > 0).then(|| (sum / count as f64).sqrt())
+    if deviations.is_empty() {
+        return None;
+    }
+    deviations.sort_by(f64::total_cmp);
+    let n = deviations.len();
+    let median = if n % 2 == 1 { deviations[n / 2] } else { 0.5 * (deviations[n / 2 - 1] + deviations[n / 2]) };
+    // The median absolute value of a normal deviate is 0.6745 of its standard deviation.
+    Some(median / 0.674_489_750_196_081_7)
 }
 
 /// The end of the stretch range: the largest stretch, or the first stretch (on a 400-step
@@ -457,10 +465,10 @@ mod tests {
         for (t, p) in chosen.targets.iter().zip(&points) {
             assert_eq!((t.stretch, t.force_n, t.readings), (p.stretch, p.force_n, 1));
         }
-        // Against its neighbours' line each reading is off by 0.04 N; the rule divides the
-        // variance by 1 + 1/4 + 1/4.
+        // Against its neighbours' line each reading is off by 0.04 N; the rule divides it by
+        // √(1 + 1/4 + 1/4) and takes the median as 0.6745 standard deviations.
         let noise = chosen.targets[0].force_noise_n;
-        assert!((noise - 0.04 / 1.5f64.sqrt()).abs() < 1e-12, "{noise}");
+        assert!((noise - 0.04 / 1.5f64.sqrt() / 0.674_489_750_196_081_7).abs() < 1e-12, "{noise}");
         // Five targets from ten readings: pairs.
         let five =
             targets(&set(points), &TargetPlan { per_direction: 5, ..TargetPlan::default() }).expect("five");

@@ -30,6 +30,7 @@ use super::membrane::{
     Terms, collect_errors, fit_membrane, starting_material,
 };
 use crate::data::set::{Direction, MeasurementSet};
+use crate::cause::CauseId;
 use crate::data::targets::{Target, TargetChoice, TargetPlan, targets};
 use crate::experiments::bending_tests::{BendingTarget, BendingTest, BendingTests, BendingTestsError};
 use crate::experiments::swatch::{SimulatedReading, SwatchTest};
@@ -62,6 +63,22 @@ impl Default for ShellFitSettings {
     }
 }
 
+/// What `--model auto` chose: the causes a diagnosis of the set confirmed, which of them the
+/// membrane fits, and why the others are not.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct AutoModel {
+    /// Every confirmed cause, in the diagnosis' order.
+    pub confirmed: Vec<CauseId>,
+    /// Those whose extension the membrane fits.
+    pub fitted: Vec<CauseId>,
+    /// The others, each with the reason.
+    pub not_fitted: Vec<(CauseId, String)>,
+    /// The diagnosis' held-out errors of the base and of the extended model.
+    pub heldout_error: (f64, f64),
+    /// The diagnosis' wall time (s).
+    pub diagnosis_wall_time_s: f64,
+}
+
 /// A uniform target of the yarn-level fit (6.3).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct UniformTarget {
@@ -89,6 +106,9 @@ pub struct ShellFit {
     /// How the targets were chosen, per direction (v2).
     #[serde(default)]
     pub target_choices: Vec<TargetChoice>,
+    /// What `--model auto` chose (v2; absent for a fixed model).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub auto: Option<AutoModel>,
     /// The screening (uniform-test) fit.
     pub screening: StvkNeoHookean,
     /// Its errors against the clamped-swatch simulation.
@@ -222,6 +242,7 @@ impl Report for ShellFit {
             ));
         }
         lines.extend(self.target_choices.iter().map(|c| format!("  targets: {c}")));
+        lines.extend(self.auto.as_ref().map(AutoModel::summary));
         if !self.unconstrained.is_empty() {
             lines.push(format!("  not constrained by the data (held): {}", self.unconstrained.join(", ")));
         }
@@ -235,6 +256,28 @@ impl Report for ShellFit {
         ));
         lines.extend(ShellBending::summary_lines(self.bending.as_ref()));
         lines.join("\n")
+    }
+}
+
+impl AutoModel {
+    /// The summary line of the choice.
+    fn summary(&self) -> String {
+        let names = |ids: &mut dyn Iterator<Item = &CauseId>| {
+            let v: Vec<&str> = ids.map(|c| c.as_str()).collect();
+            if v.is_empty() { "none".to_string() } else { v.join(", ") }
+        };
+        let mut line = format!(
+            "  auto: the diagnosis confirmed {} (held-out error {:.4} -> {:.4}, {:.0} s); fitted: {}",
+            names(&mut self.confirmed.iter()),
+            self.heldout_error.0,
+            self.heldout_error.1,
+            self.diagnosis_wall_time_s,
+            names(&mut self.fitted.iter())
+        );
+        for (id, why) in &self.not_fitted {
+            line += &format!("; not fitted: {} ({why})", id.as_str());
+        }
+        line
     }
 }
 
@@ -311,14 +354,29 @@ fn percent(x: Option<f64>) -> String {
     x.map_or("-".into(), |x| format!("{:.1}%", 100.0 * x))
 }
 
-/// Fit the membrane of `settings.model` to `set`'s stretch tests.
+/// Fit the membrane of `settings.model`, a fixed model, to `set`'s stretch tests
+/// ([`crate::auto_model::fit_shell`] fits any model, `auto` included).
 pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<ShellFit, ShellFitError> {
+    let terms = settings.model.terms().ok_or(ShellFitError::Auto)?;
+    fit_shell_with(set, settings, terms, &[], None)
+}
+
+/// Fit the membrane with `terms` from `starts` (none: the starting material, nested for the
+/// jamming), recording `auto`'s choice.
+pub(crate) fn fit_shell_with(
+    set: &MeasurementSet,
+    settings: &ShellFitSettings,
+    terms: Terms,
+    starts: &[StvkNeoHookean],
+    auto: Option<AutoModel>,
+) -> Result<ShellFit, ShellFitError> {
     let started = Instant::now();
     let chosen = targets(set, &settings.plan)?;
     let targets = chosen.targets;
     let problem = Problem::new(DirectionData::group(set, &targets, |_| true), settings.spacing_m);
-    let terms = Terms::from(settings.model);
-    let start = if terms.jamming {
+    let start = if !starts.is_empty() {
+        starts.to_vec()
+    } else if terms.jamming {
         // Nested: from the (6.1) fit, with the jamming a thousandth of its starting size.
         let plain = fit_membrane(&problem, Terms { jamming: false, ..terms }, &[], &settings.lm)?.material;
         let seed = starting_material(&problem.data, terms);
@@ -352,6 +410,7 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
         simulated: fitted.into_iter().flatten().collect(),
         targets,
         target_choices: chosen.choices,
+        auto,
     })
 }
 

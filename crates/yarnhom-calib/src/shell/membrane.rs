@@ -44,6 +44,12 @@ pub enum MembraneModel {
     ///
     /// See [`StvkNeoHookean::jamming`].
     StvkNeoHookeanJamming,
+    /// Plain anisotropic StVK plus the extensions a diagnosis of the set confirms
+    /// (`calibrate diagnose`): the area terms for `area-preservation`, stiffening for
+    /// `biphasic-stretch`, jamming for `two-phase-contact`.
+    ///
+    /// See [`crate::auto_model`].
+    Auto,
 }
 
 impl MembraneModel {
@@ -53,6 +59,7 @@ impl MembraneModel {
             MembraneModel::Stvk => "anisotropic StVK",
             MembraneModel::StvkNeoHookean => "anisotropic StVK + Neo-Hookean (6.1)",
             MembraneModel::StvkNeoHookeanJamming => "anisotropic StVK + Neo-Hookean (6.1) + jamming",
+            MembraneModel::Auto => "anisotropic StVK + the extensions the diagnosis confirms",
         }
     }
 }
@@ -77,6 +84,9 @@ pub enum ShellFitError {
     /// The swatch could not be simulated at the start.
     #[error("the clamped swatch has no equilibrium at the starting material {0:?}")]
     Start(StvkNeoHookean),
+    /// `--model auto` asked of a fit that does not diagnose.
+    #[error("the auto model is chosen by a diagnosis: fit it with yarnhom_calib::auto_model::fit_shell")]
+    Auto,
 }
 
 /// Which extensions of plain anisotropic StVK a fit has.
@@ -90,13 +100,15 @@ pub(crate) struct Terms {
     pub jamming: bool,
 }
 
-impl From<MembraneModel> for Terms {
-    fn from(model: MembraneModel) -> Self {
-        Terms {
-            area: model != MembraneModel::Stvk,
+impl MembraneModel {
+    /// The terms of a fixed model (`None` for [`MembraneModel::Auto`], whose terms a diagnosis
+    /// chooses).
+    pub(crate) fn terms(self) -> Option<Terms> {
+        (self != MembraneModel::Auto).then(|| Terms {
+            area: self != MembraneModel::Stvk,
             stiffening: false,
-            jamming: model == MembraneModel::StvkNeoHookeanJamming,
-        }
+            jamming: self == MembraneModel::StvkNeoHookeanJamming,
+        })
     }
 }
 
