@@ -234,6 +234,7 @@ fn measurement_set(law: &Law, hidden: &[Hidden], sampling: Sampling) -> Measurem
             name: "independent".into(),
             pattern: "stockinette".into(),
             swatch: Swatch { length_m: 0.10, width_m: WIDTH_M, ..Swatch::default() },
+            stitch: None,
             yarn: vec![Yarn {
                 material: "wool".into(),
                 linear_density_tex: None,

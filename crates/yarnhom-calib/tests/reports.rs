@@ -8,7 +8,9 @@
 //! (and `bending`), `diagnosis.v2.json` (with bending tests) lacks `extended_material` and
 //! `yarn_level` (both lack the v4 fields `causes`, `steps`, `target_choices`,
 //! `unexplained_remainder` and the targets' standard errors), and `yarn-fit.v1.json` lacks `basis.mechanisms`; each validates against its
-//! committed schema.
+//! committed schema. `yarn-fit.v2.json` is `yarn-fit.v1.json` with the `basis.mechanisms` of
+//! the thesis (what v1 reads as) and version 2: it lacks the v3 `basis.stitch` and
+//! `basis.tile_length_per_stitch_m`.
 
 use std::path::{Path, PathBuf};
 
@@ -103,9 +105,28 @@ fn a_v1_yarn_fit_reads_as_the_thesis_mechanisms() {
     let v1 = document("yarn-fit.v1.json");
     assert!(v1["version"] == 1 && v1["basis"].get("mechanisms").is_none());
     let fit: YarnFit = read_report(&fixture("yarn-fit.v1.json")).expect("migrates");
-    assert_eq!((fit.version, fit.basis.mechanisms), (2, YarnMechanisms::THESIS));
+    assert_eq!((fit.version, fit.basis.mechanisms), (3, YarnMechanisms::THESIS));
+    assert_eq!((fit.basis.stitch, fit.basis.tile_length_per_stitch_m), (None, None));
     let thesis = json!({ "biphasic_stretch": true, "inner_contact": "held" });
-    assert_eq!(serde_json::to_value(&fit).expect("json"), upgraded(v1, 2, &[("/basis/mechanisms", thesis)]));
+    assert_eq!(serde_json::to_value(&fit).expect("json"), upgraded(v1, 3, &[("/basis/mechanisms", thesis)]));
+}
+
+#[test]
+fn a_v2_yarn_fit_reads_without_a_stitch() {
+    // Fitted before `[stitch]` was used: the generator's default stitch and the thesis' R_2.
+    let v2 = document("yarn-fit.v2.json");
+    assert!(v2["version"] == 2 && v2["basis"].get("stitch").is_none());
+    let fit: YarnFit = read_report(&fixture("yarn-fit.v2.json")).expect("migrates");
+    assert_eq!((fit.version, fit.basis.stitch, fit.basis.tile_length_per_stitch_m), (3, None, None));
+    assert_eq!(serde_json::to_value(&fit).expect("json"), upgraded(v2, 3, &[]));
+    let v1: YarnFit = read_report(&fixture("yarn-fit.v1.json")).expect("migrates");
+    assert_eq!(fit, v1, "v1 and v2 of the same fit read the same");
+    assert!(
+        fit.summary()
+            .contains("stitch: not recorded (a pattern file, or a fit written before v3) (R_2 = 0.25 R_est)"),
+        "{}",
+        fit.summary()
+    );
 }
 
 #[test]

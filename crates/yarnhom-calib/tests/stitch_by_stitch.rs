@@ -5,8 +5,10 @@
 use std::path::{Path, PathBuf};
 
 use hdf5::types::VarLenUnicode;
-use yarnhom_calib::data::set::{Direction, MeasurementSet, Phase, StretchPoint};
-use yarnhom_calib::data::stitch_by_stitch::{Import, SATURATION_FORCE_N, StretchGauge, import};
+use yarnhom_calib::data::set::{Direction, MeasurementSet, PatternSource, Phase, StretchPoint};
+use yarnhom_calib::data::stitch_by_stitch::{
+    Import, SATURATION_FORCE_N, StretchGauge, import, import_fabric,
+};
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic/");
 
@@ -316,4 +318,60 @@ fn a_file_mixing_gauges_is_refused() {
         message.contains("video2 reads the stretch between the clamps, video1 between the top/bottom pins"),
         "{message}"
     );
+}
+
+#[test]
+fn the_acrylic_sets_carry_the_authors_stitches() {
+    // The authors' configs (`code/fabric_simulations/<pattern>config.dat`, mm): stitch length,
+    // yarn radius, core radius.
+    let configs = [
+        ("garter", 10.55, 0.54, 0.255),
+        ("rib", 16.10, 1.18, 0.41),
+        ("seed", 15.67, 1.20, 0.285),
+        ("stockinette", 11.28, 0.74, 0.325),
+    ];
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (pattern, length, radius, core) in configs {
+        let paths = [file(&format!("acrylic-{pattern}-x")), file(&format!("acrylic-{pattern}-y"))];
+        let imported = import_fabric(&paths, 50).expect("import");
+        let stitch = imported.set.fabric.stitch.expect("a stitch");
+        let mm = |v: f64| v * 1e3;
+        assert!((mm(stitch.length_m) - length).abs() < 1e-9, "{pattern}: {stitch:?}");
+        assert!((mm(stitch.yarn_radius_m) - radius).abs() < 1e-9, "{pattern}: {stitch:?}");
+        assert!((mm(stitch.core_radius_m.expect("core")) - core).abs() < 1e-9, "{pattern}: {stitch:?}");
+        assert_eq!((stitch.courses_per_m, stitch.wales_per_m), (None, None));
+        let report = imported.report();
+        let first = report.lines().next().expect("lines");
+        assert!(
+            first.starts_with("stitch: from the authors' yarn-level simulations (sabetta/stitch-by-stitch"),
+            "{first}"
+        );
+        assert!(report.lines().last().expect("lines").starts_with("total: "));
+        // Written to fabric.toml and read back exactly.
+        let set_dir = dir.path().join(pattern);
+        imported.set.write(&set_dir).expect("write");
+        assert_eq!(MeasurementSet::read(&set_dir).expect("read").fabric.stitch, Some(stitch));
+        // A single file gets it too.
+        assert_eq!(import(&paths[0], 50).expect("import").set.fabric.stitch, Some(stitch));
+        // The set's tile is generated for it: the stitch's yarn radius and length per stitch.
+        let PatternSource::Generator(generator) =
+            imported.set.fabric.pattern_source(&set_dir).expect("a generator")
+        else {
+            panic!("{pattern}: a generator")
+        };
+        let tile = generator.generate().expect("generates");
+        assert!(tile.yarns.iter().all(|y| y.radius_m == stitch.yarn_radius_m), "{pattern}");
+        let per_stitch = yarnhom_pattern::length_per_stitch_m(&tile).expect("a generated knit");
+        assert!((per_stitch / stitch.length_m - 1.0).abs() < 0.01, "{pattern}: {per_stitch}");
+    }
+}
+
+#[test]
+fn files_of_other_yarns_get_no_stitch() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let renamed = dir.path().join("cotton-rib-x.h5");
+    std::fs::copy(file("acrylic-rib-x"), &renamed).expect("copy");
+    let imported = import(&renamed, 50).expect("import");
+    assert_eq!(imported.set.fabric.stitch, None);
+    assert!(!imported.report().contains("stitch:"));
 }

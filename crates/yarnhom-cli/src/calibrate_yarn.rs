@@ -25,7 +25,7 @@ use crate::output::{create_dir, write_bytes};
 #[derive(Debug, Args)]
 pub struct YarnArgs {
     /// The measurement set directory. Its `pattern` is the input yarn geometry: a built-in
-    /// generator name (default stitch size) or a pattern file (relative to the set).
+    /// generator name (for the set's `[stitch]`, else the default stitch) or a pattern file.
     pub set: PathBuf,
     /// Output directory (created).
     #[arg(short, long)]
@@ -152,10 +152,10 @@ pub(crate) fn print_progress(event: YarnFitEvent) {
 }
 
 /// The input geometry of the set in `set_dir`: its pattern file, read like any input, or its
-/// built-in generator ([`yarnhom_calib::data::set::Fabric::pattern_source`]).
+/// built-in generator for its stitch ([`yarnhom_calib::data::set::Fabric::pattern_source`]).
 pub(crate) fn set_pattern(set_dir: &Path, set: &MeasurementSet) -> Result<Pattern> {
     Ok(match set.fabric.pattern_source(set_dir)? {
         PatternSource::File(path) => open_artifact::<Pattern>(&path)?.value,
-        PatternSource::Generator { name, params } => yarnhom_pattern::generate(&name, &params)?,
+        PatternSource::Generator(generator) => generator.generate()?,
     })
 }

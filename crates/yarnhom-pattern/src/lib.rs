@@ -4,6 +4,7 @@ mod curve;
 pub mod knit;
 pub mod min_distance;
 pub mod mirror;
+pub mod stitch;
 pub mod weave;
 
 use yarnhom_artifacts::{Fabric, Pattern, Yarn};
@@ -13,6 +14,9 @@ pub use min_distance::{
     EdgeRef, MinDistance, YarnNeighbours, closest_yarns, edge_clearances, min_inter_yarn_distance,
 };
 pub use mirror::{Mirror, MirrorAxis, MirrorError, find_mirror, mirrored};
+pub use stitch::{
+    StitchSpec, StitchTile, centreline_length_m, generate_stitch, knit_generator_of, length_per_stitch_m,
+};
 
 /// The smallest centreline distance between yarn pieces that a generated pattern keeps, in yarn
 /// radii (touching yarns are 2 radii apart; the published relaxed tiles come to 1.87-1.98).
@@ -65,6 +69,16 @@ pub enum GenerateError {
         params: GeneratorParams,
         /// Closest centreline distance, in yarn radii.
         distance_r: f64,
+    },
+    /// No tile of the generator has the stitch asked for ([`GeneratorInfo::generate_stitch`]).
+    #[error("{name} for stitch {spec}: {message}")]
+    Stitch {
+        /// Generator name.
+        name: String,
+        /// The stitch asked for.
+        spec: Box<StitchSpec>,
+        /// What is wrong.
+        message: String,
     },
 }
 

@@ -1,7 +1,7 @@
 //! Measurement sets: what was measured on a real fabric swatch, as a directory of plain files.
 //!
 //! ```text
-//! DIR/fabric.toml    name, pattern, [swatch], [[yarn]]
+//! DIR/fabric.toml    name, pattern, [swatch], [stitch], [[yarn]]
 //! DIR/stretch.csv    direction,stretch,force_n,compression,phase,repeat
 //! DIR/bending.csv    direction,clamp_distance_m,aspect_ratio      (optional)
 //! DIR/cantilever.csv direction,face,overhang_m,tip_drop_m         (optional)
@@ -18,9 +18,9 @@ use std::path::{Path, PathBuf};
 
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
-use yarnhom_artifacts::InputRef;
 use yarnhom_artifacts::container::content_hash;
-use yarnhom_pattern::{GenerateError, GeneratorParams};
+use yarnhom_artifacts::{InputRef, Pattern};
+use yarnhom_pattern::{GenerateError, GeneratorParams, StitchSpec};
 
 /// File name of the fabric description in a measurement set.
 pub const FABRIC_FILE: &str = "fabric.toml";
@@ -239,6 +239,11 @@ pub struct Fabric {
     /// Swatch dimensions (defaults of thesis Sec. 6.2.3 when the table is absent).
     #[serde(default)]
     pub swatch: Swatch,
+    /// The fabric's own stitch, if known: a generated `pattern` is built for it, and its core
+    /// radius holds the yarn model's inner contact radius (absent: the generator's default
+    /// stitch and the thesis' `R_2`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stitch: Option<Stitch>,
     /// The yarns the fabric is made of, if known.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub yarn: Vec<Yarn>,
@@ -249,18 +254,39 @@ pub struct Fabric {
 pub enum PatternSource {
     /// A pattern file (`.pattern.yh`, a JSON document, an HDF5 export or a `.pyp`).
     File(PathBuf),
-    /// A built-in generator at its default stitch size.
-    Generator {
-        /// The generator's name.
-        name: String,
-        /// Its default parameters.
-        params: GeneratorParams,
-    },
+    /// A built-in generator.
+    Generator(Generator),
+}
+
+/// A built-in generator as a set uses it: at its default stitch size, or for the set's
+/// `[stitch]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Generator {
+    /// The generator's name.
+    pub name: String,
+    /// Its default parameters.
+    pub params: GeneratorParams,
+    /// The set's stitch, if it gives one: the tile is generated for it
+    /// ([`yarnhom_pattern::generate_stitch`]) instead of at the default parameters.
+    pub stitch: Option<StitchSpec>,
+}
+
+impl Generator {
+    /// The generated tile: [`yarnhom_pattern::generate_stitch`] for the set's stitch (yarn length
+    /// per stitch within 1%, the stitch's yarn radius), else the generator at its defaults.
+    pub fn generate(&self) -> std::result::Result<Pattern, GenerateError> {
+        match &self.stitch {
+            Some(spec) => Ok(yarnhom_pattern::generate_stitch(&self.name, spec)?.pattern),
+            None => yarnhom_pattern::generate(&self.name, &self.params),
+        }
+    }
 }
 
 impl Fabric {
     /// The input geometry of the set in `set_dir`: the file `pattern` names (relative to the
-    /// set's directory, or as given), else the built-in generator of that name.
+    /// set's directory, or as given), else the built-in generator of that name, for the set's
+    /// `[stitch]` if it has one. A pattern file is used as it is: `[stitch]` does not change
+    /// its geometry.
     pub fn pattern_source(&self, set_dir: &Path) -> Result<PatternSource> {
         let spec = &self.pattern;
         let candidates = [set_dir.join(spec), PathBuf::from(spec)];
@@ -272,7 +298,66 @@ impl Fabric {
             spec: spec.clone(),
             source,
         })?;
-        Ok(PatternSource::Generator { name: spec.clone(), params })
+        let stitch = self.stitch.as_ref().map(Stitch::spec);
+        Ok(PatternSource::Generator(Generator { name: spec.clone(), params, stitch }))
+    }
+}
+
+/// `[stitch]`: the fabric's own stitch.
+///
+/// The yarn length per stitch is the centreline length of yarn in one stitch (for a periodic
+/// tile: the total centreline length of its yarns over its stitches); the core radius is the
+/// radius of the yarn's incompressible part, to which a yarn squashed in its crossings can give.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, JsonSchema)]
+#[serde(deny_unknown_fields)]
+pub struct Stitch {
+    /// Yarn length per stitch, in metres (required in the table).
+    pub length_m: f64,
+    /// Yarn radius, in metres (required in the table).
+    pub yarn_radius_m: f64,
+    /// Radius of the yarn's incompressible core, in metres (below the yarn radius), if known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub core_radius_m: Option<f64>,
+    /// Courses per metre, if known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub courses_per_m: Option<f64>,
+    /// Wales per metre, if known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wales_per_m: Option<f64>,
+}
+
+impl Stitch {
+    /// The stitch as the knit generators take it.
+    pub fn spec(&self) -> StitchSpec {
+        StitchSpec {
+            length_m: self.length_m,
+            yarn_radius_m: self.yarn_radius_m,
+            core_radius_m: self.core_radius_m,
+            courses_per_m: self.courses_per_m,
+            wales_per_m: self.wales_per_m,
+        }
+    }
+}
+
+/// A length in millimetres to 0.1 µm, without trailing zeros (`11.28`, `0.325`).
+fn mm(metres: f64) -> String {
+    let text = format!("{:.4}", metres * 1e3);
+    text.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+impl fmt::Display for Stitch {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} mm of yarn per stitch, yarn radius {} mm", mm(self.length_m), mm(self.yarn_radius_m))?;
+        if let Some(c) = self.core_radius_m {
+            write!(f, ", core radius {} mm", mm(c))?;
+        }
+        if let Some(n) = self.courses_per_m {
+            write!(f, ", {n} courses/m")?;
+        }
+        if let Some(n) = self.wales_per_m {
+            write!(f, ", {n} wales/m")?;
+        }
+        Ok(())
     }
 }
 
@@ -525,6 +610,9 @@ impl MeasurementSet {
     /// force ranges, then the bending points per direction.
     pub fn summary(&self) -> String {
         let mut lines = vec![format!("fabric: {} (pattern {})", self.fabric.name, self.fabric.pattern)];
+        if let Some(stitch) = &self.fabric.stitch {
+            lines.push(format!("stitch: {stitch}"));
+        }
         for direction in Direction::ALL.into_iter().filter(|&d| self.stretch.iter().any(|p| p.direction == d))
         {
             lines.push(format!("swatch ({direction}): {}", self.fabric.swatch.specimen(direction)));
@@ -672,6 +760,11 @@ fn validate_fabric(path: &Path, fabric: &Fabric) -> Result<()> {
     if let Some((field, message)) = gauge_problem(&fabric.swatch) {
         return Err(field_error(field, message));
     }
+    if let Some(stitch) = &fabric.stitch
+        && stitch.core_radius_m.is_some_and(|c| c >= stitch.yarn_radius_m)
+    {
+        return Err(field_error("stitch.core_radius_m".into(), "must be below stitch.yarn_radius_m"));
+    }
     for (i, yarn) in fabric.yarn.iter().enumerate() {
         if yarn.mass_fraction.is_some_and(|m| m > 1.0) {
             return Err(field_error(format!("yarn[{i}].mass_fraction"), "must be at most 1"));
@@ -699,6 +792,13 @@ fn positive_fields(fabric: &Fabric) -> Vec<(String, Option<f64>)> {
             positive.push((key("stretch_gauge_m"), o.stretch_gauge_m));
             positive.push((key("compression_gauge_m"), o.compression_gauge_m));
         }
+    }
+    if let Some(stitch) = &fabric.stitch {
+        positive.push(("stitch.length_m".to_string(), Some(stitch.length_m)));
+        positive.push(("stitch.yarn_radius_m".to_string(), Some(stitch.yarn_radius_m)));
+        positive.push(("stitch.core_radius_m".to_string(), stitch.core_radius_m));
+        positive.push(("stitch.courses_per_m".to_string(), stitch.courses_per_m));
+        positive.push(("stitch.wales_per_m".to_string(), stitch.wales_per_m));
     }
     for (i, yarn) in fabric.yarn.iter().enumerate() {
         positive.push((format!("yarn[{i}].linear_density_tex"), yarn.linear_density_tex));
@@ -995,6 +1095,13 @@ mod tests {
                     warp: Some(SwatchOverride { length_m: Some(0.12), ..Default::default() }),
                     ..Swatch::default()
                 },
+                stitch: Some(Stitch {
+                    length_m: 11.28e-3,
+                    yarn_radius_m: 0.74e-3,
+                    core_radius_m: Some(0.74e-3 / 3.0),
+                    courses_per_m: None,
+                    wales_per_m: Some(1.0 / 3.0e-3),
+                }),
                 yarn: vec![Yarn {
                     material: "acrylic".into(),
                     linear_density_tex: Some(50.0),
@@ -1212,5 +1319,78 @@ weft,up,0.05
         std::fs::write(&fabric, "name = \"x\"\n").expect("write");
         let error = MeasurementSet::read(dir.path()).expect_err("must fail").to_string();
         assert!(error.contains("fabric.toml") && error.contains("pattern"), "{error}");
+    }
+
+    /// Write a fabric.toml of `text` beside a valid stretch.csv and return the read result.
+    fn read_fabric_text(text: &str) -> (tempfile::TempDir, Result<MeasurementSet>) {
+        let dir = tempfile::tempdir().expect("tempdir");
+        example().write(dir.path()).expect("write");
+        std::fs::write(dir.path().join(FABRIC_FILE), text).expect("write");
+        let read = MeasurementSet::read(dir.path());
+        (dir, read)
+    }
+
+    #[test]
+    fn a_stitch_table_reads_validates_and_round_trips() {
+        let text = "name = \"x\"\npattern = \"rib\"\n[stitch]\nlength_m = 0.0161\nyarn_radius_m = 0.00118\n";
+        let (_dir, set) = read_fabric_text(text);
+        let stitch = set.expect("read").fabric.stitch.expect("a stitch");
+        assert_eq!((stitch.length_m, stitch.yarn_radius_m, stitch.core_radius_m), (0.0161, 0.00118, None));
+        let cases = [
+            (
+                "length_m = -0.01\nyarn_radius_m = 0.001",
+                "field `stitch.length_m`: must be a finite number > 0",
+            ),
+            (
+                "length_m = 0.01\nyarn_radius_m = 0",
+                "field `stitch.yarn_radius_m`: must be a finite number > 0",
+            ),
+            ("length_m = 0.01\nyarn_radius_m = 0.001\ncore_radius_m = nan", "field `stitch.core_radius_m`"),
+            (
+                "length_m = 0.01\nyarn_radius_m = 0.001\ncore_radius_m = 0.001",
+                "field `stitch.core_radius_m`: must be below stitch.yarn_radius_m",
+            ),
+            ("length_m = 0.01\nyarn_radius_m = 0.001\ncourses_per_m = inf", "field `stitch.courses_per_m`"),
+            ("length_m = 0.01\nyarn_radius_m = 0.001\nwales_per_m = -5", "field `stitch.wales_per_m`"),
+            ("yarn_radius_m = 0.001", "length_m"),
+            ("length_m = 0.01", "yarn_radius_m"),
+            ("length_m = 0.01\nyarn_radius_m = 0.001\nloop_m = 1", "loop_m"),
+        ];
+        for (table, expected) in cases {
+            let (_dir, read) =
+                read_fabric_text(&format!("name = \"x\"\npattern = \"rib\"\n[stitch]\n{table}\n"));
+            let error = read.expect_err("must fail").to_string();
+            assert!(error.contains("fabric.toml") && error.contains(expected), "{error} lacks {expected}");
+        }
+    }
+
+    #[test]
+    fn a_set_without_a_stitch_uses_the_generator_defaults_and_with_one_its_stitch() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let without = MeasurementSet { fabric: Fabric { stitch: None, ..example().fabric }, ..example() };
+        without.write(dir.path()).expect("write");
+        let text = std::fs::read_to_string(dir.path().join(FABRIC_FILE)).expect("read");
+        assert!(!text.contains("stitch"), "{text}");
+        let PatternSource::Generator(g) = without.fabric.pattern_source(dir.path()).expect("generator")
+        else {
+            panic!("a generator")
+        };
+        assert_eq!(g.stitch, None);
+        let defaults = GeneratorParams::defaults_for("stockinette").expect("known");
+        assert_eq!(
+            g.generate().expect("generates"),
+            yarnhom_pattern::generate("stockinette", &defaults).expect("generates")
+        );
+        // With the stitch (wales fixed at 3 mm): the stitch's radius and length per stitch.
+        let with = example().fabric;
+        let PatternSource::Generator(g) = with.pattern_source(dir.path()).expect("generator") else {
+            panic!("a generator")
+        };
+        let pattern = g.generate().expect("generates");
+        assert!(pattern.yarns.iter().all(|y| y.radius_m == 0.74e-3));
+        let length = yarnhom_pattern::length_per_stitch_m(&pattern).expect("generated");
+        assert!((length / 11.28e-3 - 1.0).abs() < 0.01, "{length}");
+        assert!((pattern.period_m[0] - 3.0e-3).abs() < 1e-12, "one wale of 3 mm: {:?}", pattern.period_m);
+        assert!(example().summary().contains("stitch: 11.28 mm of yarn per stitch, yarn radius 0.74 mm"));
     }
 }

@@ -73,13 +73,20 @@
 //! - **Directions.** Files ending in `-x` are pulled along the courses (`weft`), `-y` along the
 //!   wales (`warp`). The pattern is the file name's middle part (`garter`, `rib`, `seed`,
 //!   `stockinette`), all built-in generators of yarnhom.
+//! - **Stitch.** The files do not say what yarn or stitch the swatches were knitted with; the
+//!   authors' yarn-level simulations of the same acrylic swatches do (the repository's
+//!   `code/fabric_simulations/<pattern>config.dat`: `stitch_length` in mm, `yarn_radius` and
+//!   `core_radius` in mm). [`AUTHORS_ACRYLIC_STITCHES`] holds them, and a file whose name starts
+//!   `acrylic-` gets its pattern's entry as `fabric.toml`'s `[stitch]` (`length_m`,
+//!   `yarn_radius_m`, `core_radius_m`; no course or wale counts, the configs give none); files of
+//!   other yarns get none. [`Import::report`] says so in its first line.
 
 use std::path::{Path, PathBuf};
 
 use ::hdf5::{File, Group};
 
 use crate::data::set::{
-    Direction, Fabric, MeasurementSet, Phase, StretchPoint, Swatch, SwatchOverride, Yarn,
+    Direction, Fabric, MeasurementSet, Phase, Stitch, StretchPoint, Swatch, SwatchOverride, Yarn,
 };
 
 /// Physical size of `/clampSize` (the clamp's short dimension), in metres.
@@ -104,6 +111,31 @@ const MAD_TO_STANDARD_DEVIATION: f64 = 1.4826;
 
 /// Patterns of the stitch-by-stitch files, all built-in yarnhom generator names.
 const PATTERNS: [&str; 4] = ["garter", "rib", "seed", "stockinette"];
+
+/// Where [`AUTHORS_ACRYLIC_STITCHES`] come from.
+pub const AUTHORS_STITCH_SOURCE: &str =
+    "sabetta/stitch-by-stitch, code/fabric_simulations/<pattern>config.dat";
+
+/// The stitches the authors simulated the acrylic swatches with at yarn level (Singal et al.
+/// 2024; [`AUTHORS_STITCH_SOURCE`]): pattern, yarn length per stitch (`stitch_length`), yarn
+/// radius (`yarn_radius`) and core radius (`core_radius`), in metres (the files give mm).
+pub const AUTHORS_ACRYLIC_STITCHES: [(&str, f64, f64, f64); 4] = [
+    ("garter", 10.55e-3, 0.54e-3, 0.255e-3),
+    ("rib", 16.10e-3, 1.18e-3, 0.41e-3),
+    ("seed", 15.67e-3, 1.20e-3, 0.285e-3),
+    ("stockinette", 11.28e-3, 0.74e-3, 0.325e-3),
+];
+
+/// The authors' stitch of an acrylic swatch of `pattern` ([`AUTHORS_ACRYLIC_STITCHES`]).
+pub fn authors_acrylic_stitch(pattern: &str) -> Option<Stitch> {
+    AUTHORS_ACRYLIC_STITCHES.iter().find(|(p, ..)| *p == pattern).map(|&(_, length, radius, core)| Stitch {
+        length_m: length,
+        yarn_radius_m: radius,
+        core_radius_m: Some(core),
+        courses_per_m: None,
+        wales_per_m: None,
+    })
+}
 
 /// Why a stitch-by-stitch file could not be imported.
 #[derive(Debug, thiserror::Error)]
@@ -235,9 +267,13 @@ pub struct Import {
 }
 
 impl Import {
-    /// A human summary of kept and dropped frames, one line per video plus a total.
+    /// A human summary: where the `[stitch]` came from (if the set has one), then kept and dropped
+    /// frames, one line per video plus a total.
     pub fn report(&self) -> String {
-        let mut lines: Vec<String> = self.videos.iter().map(video_line).collect();
+        let stitch = self.set.fabric.stitch.iter().map(|stitch| {
+            format!("stitch: from the authors' yarn-level simulations ({AUTHORS_STITCH_SOURCE}): {stitch}")
+        });
+        let mut lines: Vec<String> = stitch.chain(self.videos.iter().map(video_line)).collect();
         let total = self.videos.iter().fold(VideoReport::default(), add_reports);
         lines.push(format!("total: {}", report_counts(&total)));
         lines.join("\n")
@@ -324,6 +360,7 @@ pub fn import(path: &Path, every: usize) -> Result<Import> {
             compression_gauge_m: compression_gauge_px.map(|d| d / scale_px_per_m),
             ..Swatch::default()
         },
+        stitch: file_stem(path).starts_with("acrylic-").then(|| authors_acrylic_stitch(pattern)).flatten(),
         yarn: vec![Yarn {
             material: "acrylic".into(),
             linear_density_tex: None,

@@ -402,6 +402,7 @@ mod tests {
                 name: "t".into(),
                 pattern: "rib".into(),
                 swatch: Default::default(),
+                stitch: None,
                 yarn: vec![],
             },
             stretch: points,

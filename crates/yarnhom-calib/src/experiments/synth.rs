@@ -205,6 +205,7 @@ impl SynthPlan {
                 name: name.into(),
                 pattern: "stockinette".into(),
                 swatch: Swatch::default(),
+                stitch: None,
                 yarn: vec![],
             },
             directions: Direction::ALL.to_vec(),

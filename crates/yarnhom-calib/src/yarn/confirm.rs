@@ -293,6 +293,8 @@ mod tests {
             k_s2_n: Some(100.0),
             density_kg_m3: 1.0,
             mechanisms: YarnMechanisms::BASE,
+            stitch: None,
+            tile_length_per_stitch_m: None,
         };
         YarnLevelModel {
             mechanisms: YarnMechanisms::BASE,

@@ -18,7 +18,7 @@ use yarnhom_artifacts::{Pattern, YarnModel};
 
 use super::local::{LocalReport, local_step};
 use super::objective::{DirectionTargets, SimulatedCurve, YarnErrors, errors};
-use super::params::{YarnBasis, YarnParams};
+use super::params::{InnerContact, YarnBasis, YarnParams};
 use super::problem::{TargetSource, YarnFitError, YarnFitEvent, YarnProblem};
 use super::settings::{LocalSolver, YarnFitSettings};
 use crate::data::set::{Direction, MeasurementSet};
@@ -96,9 +96,11 @@ pub struct YarnFit {
 /// Format tag of [`YarnFit`] files.
 pub const YARN_FIT_FORMAT: &str = "yarnhom.yarn-fit";
 
-/// Layout version of [`YarnFit`] files (`schemas/yarn-fit.v2.schema.json`; v2 adds
-/// `basis.mechanisms`, and v1 files read as the thesis' mechanisms).
-pub const YARN_FIT_VERSION: u32 = 2;
+/// Layout version of [`YarnFit`] files (`schemas/yarn-fit.v3.schema.json`; v2 adds
+/// `basis.mechanisms`, and v1 files read as the thesis' mechanisms; v3 adds `basis.stitch` and
+/// `basis.tile_length_per_stitch_m`, absent in v1 and v2 files, which were fitted on the
+/// generators' default stitches with the thesis' `R_2`).
+pub const YARN_FIT_VERSION: u32 = 3;
 
 /// The JSON schema of [`YarnFit`] files.
 pub fn yarn_fit_schema() -> schemars::Schema {
@@ -112,16 +114,23 @@ impl Report for YarnFit {
     /// Version 1 had no `basis.mechanisms`: it was written when the thesis' mechanisms were the
     /// only ones, and reads as them
     /// ([`YarnMechanisms::THESIS`](super::params::YarnMechanisms::THESIS), the field's default).
+    /// Versions 1 and 2 had no `basis.stitch` nor `basis.tile_length_per_stitch_m`: they were
+    /// fitted before a set's `[stitch]` was used, and read with both absent (the fields'
+    /// default: the generator's default stitch, the thesis' `R_2`).
     fn migrate(version: u32, document: serde_json::Value) -> Result<Self, yarnhom_artifacts::Error> {
-        if version != 1 {
-            return Err(yarnhom_artifacts::Error::NoMigration {
-                kind: YARN_FIT_FORMAT.into(),
-                found: version,
-                supported: YARN_FIT_VERSION,
-            });
-        }
+        let what = match version {
+            1 => "yarn-fit v1",
+            2 => "yarn-fit v2",
+            _ => {
+                return Err(yarnhom_artifacts::Error::NoMigration {
+                    kind: YARN_FIT_FORMAT.into(),
+                    found: version,
+                    supported: YARN_FIT_VERSION,
+                });
+            }
+        };
         let fit: YarnFit = serde_json::from_value(document)
-            .map_err(|e| yarnhom_artifacts::Error::Decode { what: "yarn-fit v1", message: e.to_string() })?;
+            .map_err(|e| yarnhom_artifacts::Error::Decode { what, message: e.to_string() })?;
         Ok(YarnFit { version: YARN_FIT_VERSION, ..fit })
     }
 
@@ -145,6 +154,7 @@ impl Report for YarnFit {
                 p.r2_m * 1e3,
                 p.k_c2_n_m
             ),
+            stitch_line(&self.basis),
             "  direction  comfort stress  power stress  compression".into(),
         ];
         for e in &self.errors {
@@ -170,6 +180,25 @@ impl Report for YarnFit {
         }
         lines.join("\n")
     }
+}
+
+/// The summary line on the stitch the fit used: the set's `[stitch]` or the generator's default,
+/// the tile's yarn length per stitch where known, and the rule that held `R_2`.
+fn stitch_line(basis: &YarnBasis) -> String {
+    let tile = basis.tile_length_per_stitch_m.map(|l| format!("{:.4} mm per stitch", l * 1e3));
+    let stitch = match (&basis.stitch, tile) {
+        (Some(stitch), Some(tile)) => format!("the set's, {stitch}; tile {tile}"),
+        (Some(stitch), None) => format!("the set's, {stitch}; tile from a pattern file, as it is"),
+        (None, Some(tile)) => format!("the generator's default, {tile}"),
+        (None, None) => "not recorded (a pattern file, or a fit written before v3)".to_string(),
+    };
+    let core = basis.stitch.and_then(|s| s.core_radius_m.map(|c| c / s.yarn_radius_m));
+    let r2 = match (basis.mechanisms.inner_contact, core) {
+        (InnerContact::Fitted, _) => String::new(),
+        (_, Some(fraction)) => format!(" (R_2 = {fraction:.4} R_1, the core's fraction of the yarn)"),
+        (_, None) => " (R_2 = 0.25 R_est)".to_string(),
+    };
+    format!("  stitch: {stitch}{r2}")
 }
 
 /// The search point of the lowest-cost fit among `yarn-fit.json` files (e.g. the shards' of a

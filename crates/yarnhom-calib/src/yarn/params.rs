@@ -6,6 +6,16 @@
 //! `R_2 = 0.25 R_est` and stiffness `k_c2`. `R_est` is the smallest radius at which every yarn
 //! segment of the input geometry touches another.
 //!
+//! **The fabric's own core.** Where the set's `[stitch]` gives a core radius `r_c` for its yarn
+//! radius `r`, the held `R_2` is the core scaled the way the fitted outer radius stands to the
+//! yarn: `R_2 = (r_c / r) R_1`. `R_1` is the model's outer contact radius, the counterpart of the
+//! yarn radius (it is fitted as a multiple of `R_est`, the geometry's own estimate of the yarn
+//! radius), and the inner barrier of (6.7) stands for the yarn's core; so the core keeps the
+//! fraction of the contact radius it has of the real yarn. The thesis' `0.25 R_est` is the same
+//! rule for a core a quarter of the yarn at `R_1 = R_est`. The acrylic stitches give `r_c / r`
+//! = 0.44 (stockinette), 0.47 (garter), 0.35 (rib) and 0.24 (seed). Without a core radius
+//! (or a `[stitch]`) `R_2` is the thesis' `0.25 R_est`, unchanged.
+//!
 //! Two deviations, both because the thesis states values in its code's unit system:
 //! - contact stiffnesses are in units of `k_c,base = k_s2 / R_est` (N/m), which makes a contact
 //!   barrier and a yarn stretch of the same energy scale: `k_c1 ∈ [10⁻², 10²] k_c,base` and
@@ -24,7 +34,7 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel};
 
-use crate::data::set::MeasurementSet;
+use crate::data::set::{MeasurementSet, Stitch};
 
 /// Fibre density used when the set gives no linear density (kg/m³); statics do not use it.
 pub const DEFAULT_DENSITY_KG_M3: f64 = 1000.0;
@@ -128,6 +138,15 @@ pub struct YarnBasis {
     /// The mechanisms fitted (files written before they were switchable used the thesis').
     #[serde(default)]
     pub mechanisms: YarnMechanisms,
+    /// The set's `[stitch]`, where it gives one: the stitch the input tile was generated for
+    /// (when `pattern` names a generator) and whose core radius holds `R_2` (module docs).
+    /// Absent: the generator's default stitch and the thesis' `R_2 = 0.25 R_est`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stitch: Option<Stitch>,
+    /// Yarn length per stitch of the input tile (m), where a built-in knit generator made it:
+    /// the total centreline length of its yarns over its stitches.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tile_length_per_stitch_m: Option<f64>,
 }
 
 impl YarnBasis {
@@ -142,12 +161,14 @@ impl YarnBasis {
             k_s2_n,
             density_kg_m3,
             mechanisms: YarnMechanisms::THESIS,
+            stitch: None,
+            tile_length_per_stitch_m: yarnhom_pattern::length_per_stitch_m(pattern),
         }
     }
 
     /// The basis of a yarn-level fit of `set` on `pattern`: `k_s2` is `yarn_stiffness`, else the
     /// stiffest of the set's yarns, else fitted; the density from the yarns' linear density
-    /// (else [`DEFAULT_DENSITY_KG_M3`]).
+    /// (else [`DEFAULT_DENSITY_KG_M3`]); the set's `[stitch]`, whose core radius holds `R_2`.
     pub fn of_set(set: &MeasurementSet, pattern: &Pattern, yarn_stiffness: Option<f64>) -> Self {
         let k_s2 =
             yarn_stiffness.or_else(|| set.fabric.yarn.iter().filter_map(|y| y.stiffness_n).reduce(f64::max));
@@ -155,7 +176,16 @@ impl YarnBasis {
         let tex = set.fabric.yarn.iter().find_map(|y| y.linear_density_tex);
         let density =
             tex.map_or(DEFAULT_DENSITY_KG_M3, |t| t * 1e-6 / (std::f64::consts::PI * radius * radius));
-        YarnBasis::of_pattern(pattern, k_s2, density)
+        YarnBasis { stitch: set.fabric.stitch, ..YarnBasis::of_pattern(pattern, k_s2, density) }
+    }
+
+    /// The held inner contact radius `R_2` for the outer radius `r1_m` (module docs): the
+    /// stitch's core fraction of `R_1`, else `0.25 R_est`.
+    pub fn held_r2_m(&self, r1_m: f64) -> f64 {
+        match self.stitch.and_then(|s| s.core_radius_m.map(|c| c / s.yarn_radius_m)) {
+            Some(core_fraction) => core_fraction * r1_m,
+            None => 0.25 * self.r_est_m,
+        }
     }
 
     /// The same basis fitting `mechanisms`.
@@ -198,8 +228,8 @@ impl YarnBasis {
         let (k_b_base, k_c_base) = self.stiffness_bases(k_s2_n);
         let r1_m = self.r_est_m * fitted(Coordinate::OuterRadius);
         let (r2_m, k_c2_n_m) = match self.mechanisms.inner_contact {
-            InnerContact::Off => (0.25 * self.r_est_m, 0.0),
-            InnerContact::Held => (0.25 * self.r_est_m, 1e3 * k_c_base),
+            InnerContact::Off => (self.held_r2_m(r1_m), 0.0),
+            InnerContact::Held => (self.held_r2_m(r1_m), 1e3 * k_c_base),
             InnerContact::Fitted => (
                 r1_m * fitted(Coordinate::InnerRadius),
                 k_c_base * 10f64.powf(fitted(Coordinate::InnerStiffness)),
@@ -319,6 +349,8 @@ mod tests {
                     k_s2_n: k_s2,
                     density_kg_m3: 1180.0,
                     mechanisms,
+                    stitch: None,
+                    tile_length_per_stitch_m: None,
                 };
                 let x: Vec<f64> = basis.bounds().iter().map(|(lo, hi)| lo + 0.37 * (hi - lo)).collect();
                 let back = basis.coordinates(&basis.params(&x));
@@ -348,6 +380,8 @@ mod tests {
             k_s2_n: None,
             density_kg_m3: 1.0,
             mechanisms: YarnMechanisms::THESIS,
+            stitch: None,
+            tile_length_per_stitch_m: None,
         };
         assert_eq!(
             basis.coordinate_names(),
@@ -376,6 +410,8 @@ mod tests {
             k_s2_n: Some(50.0),
             density_kg_m3: 1180.0,
             mechanisms: YarnMechanisms::BASE,
+            stitch: None,
+            tile_length_per_stitch_m: None,
         };
         let x = [0.3, 0.9, -0.4];
         let p = base.params(&x);
@@ -404,5 +440,42 @@ mod tests {
         let pattern = yarnhom_pattern::generate("stockinette", &params).expect("generates");
         let basis = YarnBasis::of_pattern(&pattern, None, 1180.0);
         assert!(basis.r_est_m > 0.9e-3 && basis.r_est_m < 2.5e-3, "R_est = {}", basis.r_est_m);
+    }
+
+    #[test]
+    fn a_core_radius_holds_r2_at_its_fraction_of_r1() {
+        let stitch = Stitch {
+            length_m: 11.28e-3,
+            yarn_radius_m: 0.74e-3,
+            core_radius_m: Some(0.325e-3),
+            courses_per_m: None,
+            wales_per_m: None,
+        };
+        let thesis = YarnBasis {
+            radius_m: 0.74e-3,
+            r_est_m: 0.4e-3,
+            k_s2_n: Some(50.0),
+            density_kg_m3: 1180.0,
+            mechanisms: YarnMechanisms::THESIS,
+            stitch: None,
+            tile_length_per_stitch_m: None,
+        };
+        let own = YarnBasis { stitch: Some(stitch), ..thesis };
+        for x in [[-0.5, 0.05, 0.5, 0.7, 0.0], [-1.0, 0.1, -1.0, 1.4, 1.0]] {
+            let (p, q) = (thesis.params(&x), own.params(&x));
+            assert_eq!(p.r2_m, 0.25 * 0.4e-3);
+            // The core is 0.325 / 0.74 of the yarn, and so R_2 of R_1; nothing else moves.
+            assert!((q.r2_m / q.r1_m - 0.325 / 0.74).abs() < 1e-15, "{q:?}");
+            assert_eq!(YarnParams { r2_m: p.r2_m, ..q }, p);
+        }
+        // Without a core radius the stitch leaves R_2 alone; a fitted R_2 ignores it.
+        let no_core = YarnBasis { stitch: Some(Stitch { core_radius_m: None, ..stitch }), ..thesis };
+        assert_eq!(no_core.params(&[-0.5, 0.05, 0.5, 0.7, 0.0]).r2_m, 0.25 * 0.4e-3);
+        let fitted = own.with_mechanisms(YarnMechanisms {
+            inner_contact: InnerContact::Fitted,
+            ..YarnMechanisms::THESIS
+        });
+        let x = [-0.5, 0.05, 0.5, 0.7, 0.0, 0.6, 1.0];
+        assert!((fitted.params(&x).r2_m - 0.6 * 0.7 * 0.4e-3).abs() < 1e-18);
     }
 }
