@@ -44,7 +44,8 @@ pub fn fit_shell(set: &MeasurementSet, settings: &ShellFitSettings) -> Result<Sh
             CauseId::BiphasicStretch => terms.stiffening = true,
             CauseId::TwoPhaseContact => terms.jamming = true,
             CauseId::FrictionHysteresis => {
-                auto.not_fitted.push((id, "an unloading effect: the shell fit fits the loading targets".into()));
+                auto.not_fitted
+                    .push((id, "an unloading effect: the shell fit fits the loading targets".into()));
                 continue;
             }
             _ => {

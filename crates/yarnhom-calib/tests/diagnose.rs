@@ -117,12 +117,18 @@ fn a_hidden_jamming_is_found_as_two_phase_contact() {
     assert!(d.gain.heldout_error_after < 0.5 * d.gain.heldout_error_before, "{:?}", d.gain);
 }
 
+/// A softening is off the catalog. It moves the contraction as well as the force, so area
+/// preservation may explain part of it (the contraction's share) and be confirmed; what no
+/// catalog cause explains is left, flagged, and never named a stiffening.
 #[test]
-fn an_effect_outside_the_catalog_is_unexplained() {
+fn an_effect_outside_the_catalog_leaves_an_unexplained_remainder() {
     let d = hidden(HiddenEffect::Softening, 1.0, 18, false);
-    assert_eq!(d.cause.id, CauseId::Unexplained, "{:#?}", d.cause);
-    assert!(d.extended.is_none());
     assert!(d.base.heldout_error.expect("held out") > 3.0 * d.noise, "structured residuals: {:?}", d.base);
+    assert!(d.cause.id == CauseId::Unexplained || d.unexplained_remainder, "{:#?}", d.cause);
+    assert!(d.gain.heldout_error_after > 3.0 * d.noise, "{:?} at noise {}", d.gain, d.noise);
+    assert!(d.causes.iter().all(|c| c.id != CauseId::BiphasicStretch), "{:?}", d.causes);
+    assert!(d.summary().contains("unexplained"), "{}", d.summary());
+    assert!(d.markdown().contains("`unexplained`"));
 }
 
 #[test]
@@ -137,7 +143,8 @@ fn hidden_hysteresis_is_found_on_the_unloading_readings() {
 #[test]
 fn the_auto_model_fits_the_stiffening_the_diagnosis_confirms() {
     let set = hidden_set(HiddenEffect::BiphasicStretch, 1.0, 13, false);
-    let settings = ShellFitSettings { model: MembraneModel::Auto, spacing_m: 0.01, ..ShellFitSettings::default() };
+    let settings =
+        ShellFitSettings { model: MembraneModel::Auto, spacing_m: 0.01, ..ShellFitSettings::default() };
     let auto = fit_shell(&set, &settings).expect("fits");
     let chosen = auto.auto.as_ref().expect("the choice is recorded");
     assert!(chosen.fitted.contains(&CauseId::BiphasicStretch), "{chosen:?}");

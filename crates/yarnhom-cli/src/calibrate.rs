@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::report::{Report, read_report, write_report};
+use yarnhom_calib::auto_model::fit_shell;
 use yarnhom_calib::cause::CauseId;
 use yarnhom_calib::data::set::{Direction, MeasurementSet, Phase};
 use yarnhom_calib::data::targets::TargetPlan;
@@ -13,7 +14,6 @@ use yarnhom_calib::diagnosis::{confirm, diagnose};
 use yarnhom_calib::experiments::pear_loop::PearLoopTest;
 use yarnhom_calib::experiments::strip::hinge_bending;
 use yarnhom_calib::experiments::synth::{HiddenEffect, SynthRequest, ground_truth};
-use yarnhom_calib::auto_model::fit_shell;
 use yarnhom_calib::shell::fit::{ShellFit, ShellFitSettings};
 use yarnhom_calib::shell::membrane::MembraneModel;
 

@@ -344,7 +344,8 @@ fn neighbour_scatter(sorted: &[&StretchPoint], value: impl Fn(&StretchPoint) -> 
     }
     deviations.sort_by(f64::total_cmp);
     let n = deviations.len();
-    let median = if n % 2 == 1 { deviations[n / 2] } else { 0.5 * (deviations[n / 2 - 1] + deviations[n / 2]) };
+    let median =
+        if n % 2 == 1 { deviations[n / 2] } else { 0.5 * (deviations[n / 2 - 1] + deviations[n / 2]) };
     // The median absolute value of a normal deviate is 0.6745 of its standard deviation.
     Some(median / 0.674_489_750_196_081_7)
 }

@@ -9,11 +9,18 @@ impl Diagnosis {
     /// yarn-level confirmation, the figures.
     pub fn markdown(&self) -> String {
         let mut md = format!(
-            "# Diagnosis of {}\n\n**Cause: `{}`** — {}.\n\n## Evidence\n\n",
+            "# Diagnosis of {}\n\n**Cause: `{}`** — {}.\n\n",
             self.fabric,
             self.cause.id.as_str(),
             self.cause.explanation
         );
+        for c in self.causes.iter().skip(1) {
+            md += &format!("Also **`{}`** — {}.\n\n", c.id.as_str(), c.explanation);
+        }
+        if let Some(remainder) = self.remainder_words() {
+            md += &format!("Also **`unexplained`** — {remainder}.\n\n");
+        }
+        md += "## Evidence\n\n";
         for line in &self.cause.evidence {
             md += &format!("- {line}\n");
         }

@@ -229,6 +229,15 @@ pub fn diagnosis_schema() -> schemars::Schema {
     schemars::schema_for!(Diagnosis)
 }
 
+impl Diagnosis {
+    /// What the verdict says of a remainder the confirmed causes leave, if they leave one.
+    pub(super) fn remainder_words(&self) -> Option<&'static str> {
+        (self.unexplained_remainder && !self.causes.is_empty()).then_some(
+            "the confirmed causes leave a held-out error above the noise: the rest is off the catalog",
+        )
+    }
+}
+
 impl Report for Diagnosis {
     const FORMAT: &'static str = DIAGNOSIS_FORMAT;
     const VERSION: u32 = DIAGNOSIS_VERSION;
@@ -276,6 +285,9 @@ impl Report for Diagnosis {
         lines.push(format!("cause: {} ({})", self.cause.id.as_str(), self.cause.explanation));
         for c in self.causes.iter().skip(1) {
             lines.push(format!("also: {} ({})", c.id.as_str(), c.explanation));
+        }
+        if let Some(remainder) = self.remainder_words() {
+            lines.push(format!("also: unexplained ({remainder})"));
         }
         for c in &self.causes {
             lines.push(format!(

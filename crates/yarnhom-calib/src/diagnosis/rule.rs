@@ -51,7 +51,13 @@ pub struct DecisionRule {
 impl Default for DecisionRule {
     /// The rule of `calibrate diagnose`.
     fn default() -> Self {
-        Self { noise_margin: 1.0, criterion_drop: 4.0, signature_left: 0.5, none_noise_multiple: 2.0, none_floor: 0.03 }
+        Self {
+            noise_margin: 1.0,
+            criterion_drop: 4.0,
+            signature_left: 0.5,
+            none_noise_multiple: 2.0,
+            none_floor: 0.03,
+        }
     }
 }
 
@@ -219,7 +225,9 @@ impl DecisionRule {
         let limit = self.noise_limit(noise);
         let within = self.within_words();
         if heldout <= limit {
-            format!("the confirmed causes leave a held-out error of {heldout:.4}, within {within} ({limit:.4})")
+            format!(
+                "the confirmed causes leave a held-out error of {heldout:.4}, within {within} ({limit:.4})"
+            )
         } else {
             format!(
                 "the confirmed causes leave a held-out error of {heldout:.4}, above {within} ({limit:.4}): the rest is unexplained by the catalog"

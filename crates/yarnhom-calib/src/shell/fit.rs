@@ -29,8 +29,8 @@ use super::membrane::{
     COMPRESSION_SCALE_FLOOR, DirectionData, FitErrors, FittedMembrane, MembraneModel, Problem, ShellFitError,
     Terms, collect_errors, fit_membrane, starting_material,
 };
-use crate::data::set::{Direction, MeasurementSet};
 use crate::cause::CauseId;
+use crate::data::set::{Direction, MeasurementSet};
 use crate::data::targets::{Target, TargetChoice, TargetPlan, targets};
 use crate::experiments::bending_tests::{BendingTarget, BendingTest, BendingTests, BendingTestsError};
 use crate::experiments::swatch::{SimulatedReading, SwatchTest};
