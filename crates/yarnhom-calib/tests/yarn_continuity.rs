@@ -74,6 +74,7 @@ fn points(problem: &YarnProblem) -> Vec<Vec<f64>> {
 }
 
 #[test]
+#[ignore = "item 6 of issue 30, not yet measured: the rest-shape estimation is not yet branch-stable"]
 fn the_objective_is_continuous_at_round_off_at_the_box_midpoint() {
     let problem = stock_problem();
     let targets = problem.targets(YarnFitSettings::default().swarm_targets).expect("shell targets");
