@@ -112,7 +112,10 @@ fn synth_then_diagnose_names_the_hidden_effect_and_writes_the_report() {
     assert!(dir.path().join("truth.json").exists());
     let o = yarnhom(&["calibrate", "diagnose", "set", "-o", "out", "--budget", "quick"], dir.path());
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(text(&o.stdout).starts_with("cause: friction-hysteresis"), "{}", text(&o.stdout));
+    // The targets chosen come first, then the verdict.
+    let stdout = text(&o.stdout);
+    assert!(stdout.starts_with("targets: weft load: 10 targets"), "{stdout}");
+    assert!(stdout.lines().any(|l| l.starts_with("cause: friction-hysteresis")), "{stdout}");
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("out/report.json")).expect("json"))
             .expect("parses");
