@@ -9,8 +9,11 @@
 //! x0.8; wovens: rest curvatures x0.9) and finally shrinks or grows the periods to the in-plane
 //! energy minimum, so that the relaxed tile carries no in-plane stress at zero strain but keeps
 //! its tendency to curl. Sec. 6.5.2 instead bounds the change of every rest length to 20% of its
-//! input value and runs few Newton iterations per early reset, so the estimated rest state stays
-//! close to the input geometry and keeps a balanced pre-tension.
+//! input value and moves the yarns little per reset, so the estimated rest state stays close to
+//! the input geometry and keeps a balanced pre-tension. Where the thesis cuts the early resets'
+//! solves after a few Newton steps, each reset here is one implicit step of the tile's gradient
+//! flow (a proximal solve with a unique minimum), so the estimate, and the yarn-level objective
+//! (6.11) built on it, is a continuous function of the yarn's parameters.
 
 use nalgebra::{Matrix2, Vector2};
 use yarnhom_artifacts::{Fabric, Pattern, RestState, YarnModel};
@@ -20,7 +23,7 @@ use yarnhom_rod::EdgeFrame;
 use crate::assembly::{RveState, bend_strains, edge_lengths, world_positions};
 use crate::homogenize::{placement, solve_at, stress_at_equilibrium};
 use crate::model::{RveError, RveModel};
-use crate::solve::{SolveOptions, SolveReport, StopReason};
+use crate::solve::{SolveOptions, SolveReport, StopReason, proximal_weight};
 
 /// Which rest-state procedure to run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -164,7 +167,7 @@ pub fn relax(
         let input_lengths = current.rest.as_ref().map(|r| r.edge_length_m.clone()).unwrap_or_default();
         for reset in 0..options.max_resets {
             let tile = RveModel::new(&current, yarn)?;
-            let solve_options = reset_solve_options(options, reset);
+            let solve_options = reset_solve_options(options, &tile);
             let (solved, state) = solve_at(&tile, &zero_strain(), None, &solve_options);
             report.iterations += solved.iterations;
             if !solved.converged && solved.reason != StopReason::IterationLimit {
@@ -205,7 +208,7 @@ pub fn relax(
         report.period_strain = [total[0] - 1.0, total[1] - 1.0];
     } else {
         let tile = RveModel::new(&current, yarn)?;
-        let (solved, state) = solve_at(&tile, &zero_strain(), None, &options.solve);
+        let (solved, state) = solve_at(&tile, &zero_strain(), None, &estimated_equilibrium_options(options));
         report.iterations += solved.iterations;
         if !solved.converged {
             return Err(not_converged("rest-shape estimation", &solved));
@@ -243,16 +246,46 @@ fn not_converged(stage: &'static str, solved: &SolveReport) -> RelaxError {
     RelaxError::NotConverged { stage, reason: solved.reason, iterations: solved.iterations }
 }
 
-/// Sec. 6.5.2: "at initial steps ... we run only a few simulation steps before resetting rest
-/// shapes. At later steps, contacts become smooth, and we let simulations run toward
-/// convergence." Algorithm 2 relaxes fully every time.
-fn reset_solve_options(options: &RelaxOptions, reset: usize) -> SolveOptions {
+/// How far one reset of the estimation moves the yarns where nothing resists, in yarn radii.
+const REST_FLOW_STEP_RADII: f64 = 0.25;
+
+/// The solve of one rest-shape reset. Algorithm 2 relaxes fully every time. Sec. 6.5.2 runs
+/// "only a few simulation steps" per early reset, then "toward convergence"; a solve cut off
+/// after a few Newton steps, or run to convergence on a tile whose rods were just put at rest
+/// (where contact alone drives the yarns through a nearly flat landscape), ends wherever its
+/// step decisions lead, and round-off then picks among equilibria (a relative change of 1e-13
+/// in one yarn parameter moved (6.11) by 25%). Instead each reset is one implicit step of the
+/// tile's gradient flow: the solve converges to the unique minimum of the energy plus a
+/// proximal anchor at the reset's start ([`SolveOptions::proximal_weight`]), sized so that no
+/// yarn moves more than [`REST_FLOW_STEP_RADII`] radii where nothing resists. Each reset is
+/// then a continuous map of the parameters, and so is the estimation.
+fn reset_solve_options(options: &RelaxOptions, tile: &RveModel) -> SolveOptions {
     match options.method {
         RelaxMethod::Reference => options.solve,
         RelaxMethod::Estimation { .. } => {
-            let limit = if reset < 5 { 5 * (reset + 1) } else { options.solve.max_iterations };
-            SolveOptions { max_iterations: limit, ..options.solve }
+            let place = placement(tile, &zero_strain());
+            let start = RveState::affine(tile, &place);
+            let weight = proximal_weight(tile, &place, &start, REST_FLOW_STEP_RADII);
+            // The anchor, not the cold regularization schedule, keeps the first steps short.
+            let regularization = SolveOptions::warm_started().regularization;
+            SolveOptions { proximal_weight: weight, regularization, ..options.solve }
         }
+    }
+}
+
+/// Tolerance (A.33) of the estimation's last equilibrium, where the rods take the pre-tension
+/// that balances the contacts: tight enough that the solve ends in Newton's quadratic regime,
+/// not wherever a slow approach first crosses the default `1e-5`.
+const ESTIMATED_EQUILIBRIUM_TOLERANCE: f64 = 1e-7;
+
+/// The solve of the estimation's last equilibrium: from the last reset's configuration, which is
+/// collision-free, so without the cold start's strong early regularization (whose schedule
+/// makes the path, and on a soft tile the equilibrium reached, depend on the iteration count).
+fn estimated_equilibrium_options(options: &RelaxOptions) -> SolveOptions {
+    SolveOptions {
+        regularization: SolveOptions::warm_started().regularization,
+        tolerance: options.solve.tolerance.min(ESTIMATED_EQUILIBRIUM_TOLERANCE),
+        ..options.solve
     }
 }
 

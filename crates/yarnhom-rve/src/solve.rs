@@ -46,6 +46,13 @@ pub struct SolveOptions {
     pub regularization_iterations: usize,
     /// How a Newton step is kept from tunnelling yarns through each other.
     pub step_control: StepControl,
+    /// `μ` of a proximal anchor at the start (N/m; 0: none). The solve then finds the minimum
+    /// of `E(g) + μ/2 ‖M⁻¹(g - g₀)‖²` instead of `E`: one implicit step of the energy's
+    /// gradient flow from the start `g₀`, in the scaled coordinates of (A.30), so `μ` adds to
+    /// the scaled Hessian's diagonal. For `μ` above the most negative curvature of `E` that
+    /// minimum is unique and moves continuously with the tile's parameters (the rest-shape
+    /// estimation's resets, [`crate::relax()`]).
+    pub proximal_weight: f64,
 }
 
 /// Collision-safe steps (A.2.3).
@@ -69,6 +76,7 @@ impl Default for SolveOptions {
             regularization: (5000.0, 5.0),
             regularization_iterations: 400,
             step_control: StepControl::StepLimit,
+            proximal_weight: 0.0,
         }
     }
 }
@@ -225,7 +233,8 @@ pub fn solve_observed(
     let residual = |gradient: &DVector<f64>| projected(&c, gradient).norm();
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
-    let mut assembler = Assembler::new(model, placement);
+    let anchor = (options.proximal_weight > 0.0).then(|| Anchor::new(options.proximal_weight, &state.g, &scale));
+    let mut assembler = Assembler { model, placement, candidates: None, anchor };
     let mut current = assembler.assemble(state, &state.g, Want::DerivativesLower);
     let (reason, iterations) = 'solve: {
         for iteration in 0..options.max_iterations {
@@ -240,7 +249,8 @@ pub fn solve_observed(
             let scaled_gradient = current.gradient.component_mul(&scale);
             let alpha = a0 * (an / a0).powf(t) * scaled_gradient.amax();
             scale_hessian(&mut current.hessian, &scale);
-            if !(solver.load(n, &current.hessian).is_ok() && factor_regularized(&mut solver, alpha)) {
+            let shift = alpha + options.proximal_weight;
+            if !(solver.load(n, &current.hessian).is_ok() && factor_regularized(&mut solver, shift)) {
                 break 'solve (StopReason::FactorizationFailed, iteration);
             }
             let step = constrained_step(&solver, &c_scaled, &scaled_gradient, &(&c * &state.g - &target))
@@ -276,7 +286,7 @@ pub fn solve_observed(
         (StopReason::IterationLimit, options.max_iterations)
     };
     let ratio = residual(&current.gradient) / first;
-    let energy_j = current.energy_j;
+    let energy_j = current.energy_j - assembler.anchor.as_ref().map_or(0.0, |a| a.energy_j(&state.g));
     observe(&Iterate { iteration: iterations, energy_j, gradient_ratio: ratio, step_length: 0.0, state });
     SolveReport {
         converged: reason == StopReason::Converged,
@@ -309,28 +319,58 @@ pub(crate) fn largest_vertex_move_m(model: &RveModel, delta: &DVector<f64>) -> f
 const CANDIDATE_ALLOWANCE_RADII: f64 = 0.5;
 
 /// The assembly of one solve's iterates under its placement, reusing the contact candidates
-/// ([`ContactCandidates`]) while they cover the iterate.
+/// ([`ContactCandidates`]) while they cover the iterate, with the proximal anchor's energy and
+/// gradient added where the solve has one.
 struct Assembler<'a> {
     model: &'a RveModel,
     placement: &'a Placement,
     candidates: Option<ContactCandidates>,
+    anchor: Option<Anchor>,
 }
 
-impl<'a> Assembler<'a> {
-    fn new(model: &'a RveModel, placement: &'a Placement) -> Self {
-        Assembler { model, placement, candidates: None }
-    }
-
-    /// [`assemble`] at DOFs `g`, measured against `state`'s frames.
+impl Assembler<'_> {
+    /// [`assemble`] at DOFs `g`, measured against `state`'s frames, plus the anchor's terms
+    /// (its Hessian `μ M⁻²` is added as a shift of the scaled system).
     fn assemble(&mut self, state: &RveState, g: &DVector<f64>, want: Want) -> Assembled {
         let (model, placement) = (self.model, self.placement);
         let candidates = match self.candidates.take() {
             Some(c) if c.cover(model, g) => c,
             _ => ContactCandidates::new(model, placement, g, CANDIDATE_ALLOWANCE_RADII * model.radius_m),
         };
-        let assembled = assemble_with(model, placement, state, g, want, &candidates);
+        let mut assembled = assemble_with(model, placement, state, g, want, &candidates);
         self.candidates = Some(candidates);
+        if let Some(anchor) = &self.anchor {
+            assembled.energy_j += anchor.energy_j(g);
+            if want != Want::Energy {
+                assembled.gradient += anchor.gradient(g);
+            }
+        }
         assembled
+    }
+}
+
+/// The proximal term `μ/2 ‖M⁻¹(g - g₀)‖²` of [`SolveOptions::proximal_weight`].
+struct Anchor {
+    /// `μ` (N/m).
+    weight: f64,
+    /// `g₀`.
+    at: DVector<f64>,
+    /// The diagonal of `M⁻²`.
+    inverse_square_scale: DVector<f64>,
+}
+
+impl Anchor {
+    fn new(weight: f64, at: &DVector<f64>, scale: &DVector<f64>) -> Self {
+        Anchor { weight, at: at.clone(), inverse_square_scale: scale.map(|s| 1.0 / (s * s)) }
+    }
+
+    fn energy_j(&self, g: &DVector<f64>) -> f64 {
+        let d = g - &self.at;
+        0.5 * self.weight * d.component_mul(&d).dot(&self.inverse_square_scale)
+    }
+
+    fn gradient(&self, g: &DVector<f64>) -> DVector<f64> {
+        (g - &self.at).component_mul(&self.inverse_square_scale) * self.weight
     }
 }
 
@@ -358,6 +398,20 @@ fn scale_hessian(hessian: &mut [(usize, usize, f64)], scale: &DVector<f64>) {
 /// is held to this absolute accuracy instead of a fraction of its own vanishing first gradient.
 fn force_floor(model: &RveModel) -> f64 {
     model.material_law.stretch.density(1e-3).1 * (model.vertices as f64).sqrt()
+}
+
+/// The proximal weight `μ` ([`SolveOptions::proximal_weight`]) whose step from `state` moves no
+/// scaled coordinate by more than `step_radii` yarn radii where the energy has no curvature:
+/// `μ = max(‖M ∇E‖∞, F₀) / (step_radii r)`, `F₀` the force floor of (A.33) ([`force_floor`]),
+/// so that a tile nearly in equilibrium is still anchored. A continuous function of the state
+/// and of the yarn's parameters.
+pub(crate) fn proximal_weight(model: &RveModel, placement: &Placement, state: &RveState, step_radii: f64) -> f64 {
+    let r = model.radius_m;
+    let gradient = assemble(model, placement, state, &state.g, Want::EnergyGradient).gradient;
+    let largest = (0..gradient.len())
+        .map(|i| gradient[i].abs() * if i < 3 * model.vertices { 1.0 } else { 1e6 * r })
+        .fold(0.0, f64::max);
+    largest.max(force_floor(model)) / (step_radii * r)
 }
 
 /// Relative diagonal shift of the Hessian in [`equilibrium_response`]: enough to factor a

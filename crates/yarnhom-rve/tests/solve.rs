@@ -146,3 +146,54 @@ fn collision_detection_steps_reach_the_same_stretched_equilibrium() {
     let difference = (safe.energy_density_j_m2 / limited.energy_density_j_m2 - 1.0).abs();
     assert!(difference < 1e-4, "step limit {limited:?} vs ccd {safe:?}");
 }
+
+#[test]
+fn a_proximal_solve_is_one_implicit_step_of_the_gradient_flow() {
+    // With the anchor `μ/2 ‖M⁻¹(g - g₀)‖²` the solve stops where the tile's forces balance the
+    // anchor's pull back to the start: `∇E + μ M⁻²(g - g₀)` vanishes along every feasible
+    // direction (the constraints are linear, so the way back to the start and the way on to the
+    // plain equilibrium are both feasible). It moves less than the plain solve and reports the
+    // tile's own energy.
+    let model = stock();
+    let strain: MacroStrain = "sx=0.3".parse().expect("strain");
+    let placement = Placement::new(model.material.clone(), model.period_m, &strain);
+    let start = RveState::affine(&model, &placement);
+    let largest_move = |state: &RveState| {
+        (0..model.vertices)
+            .map(|v| (state.g.fixed_rows::<3>(3 * v) - start.g.fixed_rows::<3>(3 * v)).norm())
+            .fold(0.0, f64::max)
+    };
+    let mut plain = start.clone();
+    let plain_report = yarnhom_rve::solve(&model, &placement, &mut plain, &SolveOptions::default());
+    assert!(plain_report.converged, "{plain_report:?}");
+
+    let mu = 10.0;
+    let mut anchored = start.clone();
+    let options = SolveOptions { proximal_weight: mu, tolerance: 1e-9, ..SolveOptions::warm_started() };
+    let report = yarnhom_rve::solve(&model, &placement, &mut anchored, &options);
+    assert!(report.converged, "{report:?}");
+    let (near, far) = (largest_move(&anchored), largest_move(&plain));
+    assert!(near > 0.05 * far && near < 0.8 * far, "moved {near:e} m, the plain solve {far:e} m");
+
+    let tile = yarnhom_rve::assembly::assemble(
+        &model,
+        &placement,
+        &anchored,
+        &anchored.g,
+        yarnhom_rve::assembly::Want::EnergyGradient,
+    );
+    let reported = (report.energy_j - tile.energy_j).abs();
+    assert!(reported < 1e-12 * tile.energy_j, "the reported energy is the tile's, without the anchor: {report:?}");
+    let r = model.radius_m;
+    let pull = anchored.g.map_with_location(|i, _, g| {
+        let inverse_square_scale = if i < 3 * model.vertices { 1.0 } else { (1e6 * r).powi(-2) };
+        mu * (g - start.g[i]) * inverse_square_scale
+    });
+    for (name, direction) in [("back to the start", &start.g - &anchored.g), ("on", &plain.g - &anchored.g)] {
+        let (force, anchor) = (tile.gradient.dot(&direction), pull.dot(&direction));
+        assert!(
+            (force + anchor).abs() < 1e-6 * force.abs(),
+            "{name}: the tile's force {force:e} against the anchor's {anchor:e}"
+        );
+    }
+}
