@@ -83,3 +83,80 @@ fn real_acrylic_swatches_fit_and_diagnose() {
         assert!(*j <= plain + 0.01, "the nested fit does not lose compression: {j} vs {plain}");
     }
 }
+
+/// The authors' yarn radius and core radius per swatch (m; `sabetta/stitch-by-stitch`,
+/// `code/fabric_simulations/*config.dat`), which the importer writes into each set's `[stitch]`.
+const AUTHORS_RADII_M: [(&str, f64, f64); 4] = [
+    ("stockinette", 0.74e-3, 0.325e-3),
+    ("garter", 0.54e-3, 0.255e-3),
+    ("rib", 1.18e-3, 0.41e-3),
+    ("seed", 1.20e-3, 0.285e-3),
+];
+
+/// The yarn-level estimation (Sec. 6.5) of the four acrylic swatches on tiles generated for
+/// their own stitch, with the swarm and local budget of the validation table's reduced run
+/// (16 particles, 4 generations, 20 COBYLA evaluations): Fig. 6.15's errors per swatch and
+/// direction, the fitted radii beside the authors', the wall time. Prints the table of
+/// docs/validation.md ("The real acrylic swatches"); about 20 min on 2 cores:
+/// `cargo test -p yarnhom-calib --features hdf5 --test real_swatches -- --ignored --nocapture`.
+#[test]
+#[ignore = "about 20 min on 2 cores: four yarn-level fits"]
+fn real_acrylic_swatches_at_yarn_level_on_their_own_stitch() {
+    use yarnhom_calib::data::set::PatternSource;
+    use yarnhom_calib::optimize::swarm::SwarmSettings;
+    use yarnhom_calib::yarn::fit::fit_yarn;
+    use yarnhom_calib::yarn::params::YarnBasis;
+    use yarnhom_calib::yarn::problem::YarnProblem;
+    use yarnhom_calib::yarn::settings::YarnFitSettings;
+
+    let settings = YarnFitSettings {
+        swarm: SwarmSettings { particles: 16, generations: 4, ..SwarmSettings::default() },
+        local_budget: 20,
+        ..YarnFitSettings::default()
+    };
+    let mut comfort = Vec::new();
+    for (pattern, yarn_radius_m, core_radius_m) in AUTHORS_RADII_M {
+        let files = ["x", "y"].map(|d| format!("{DATA}/acrylic-{pattern}-{d}.h5").into());
+        let set = import_fabric(&files, 1).expect("imports").set;
+        let stitch = set.fabric.stitch.expect("the importer writes the authors' stitch");
+        assert_eq!((stitch.yarn_radius_m, stitch.core_radius_m), (yarn_radius_m, Some(core_radius_m)));
+        let shell = fit_shell(&set, &ShellFitSettings::default()).expect("fits");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let tile = match set.fabric.pattern_source(dir.path()).expect("a generator") {
+            PatternSource::Generator(generator) => generator.generate().expect("generates"),
+            PatternSource::File(path) => panic!("a file {}", path.display()),
+        };
+        let basis = YarnBasis::of_set(&set, &tile, None);
+        let vertices = tile.vertex_count();
+        let problem = YarnProblem::from_shell_fit(tile, basis, &shell, &set, &settings).expect("a problem");
+        let fitted = fit_yarn(&problem, pattern, &settings, None, &|_| {}).expect("fits");
+        let fit = &fitted.fit;
+        let line: Vec<String> = fit
+            .errors
+            .iter()
+            .map(|e| {
+                comfort.push(e.comfort_stress);
+                format!(
+                    "{} {:.1}% / {} / {:.1}%",
+                    e.direction,
+                    100.0 * e.comfort_stress,
+                    e.power_stress.map_or("-".into(), |p| format!("{:.1}%", 100.0 * p)),
+                    100.0 * e.compression
+                )
+            })
+            .collect();
+        eprintln!(
+            "{pattern} ({vertices} vertices): {}; R_1 {:.3} mm (yarn radius {:.3}), R_2 {:.3} mm (core {:.3}); g {:.4}; {:.0} s",
+            line.join("; "),
+            fit.params.r1_m * 1e3,
+            yarn_radius_m * 1e3,
+            fit.params.r2_m * 1e3,
+            core_radius_m * 1e3,
+            fit.cost,
+            fit.wall_time_s
+        );
+        assert!(fit.cost.is_finite() && fit.errors.iter().all(|e| e.comfort_stress.is_finite()));
+    }
+    let within = comfort.iter().filter(|e| **e <= 0.10).count();
+    eprintln!("comfort error within 10% in {within} of {} swatch directions", comfort.len());
+}

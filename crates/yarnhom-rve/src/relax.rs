@@ -23,7 +23,7 @@ use yarnhom_rod::EdgeFrame;
 use crate::assembly::{RveState, bend_strains, edge_lengths, world_positions};
 use crate::homogenize::{placement, solve_at, stress_at_equilibrium};
 use crate::model::{RveError, RveModel};
-use crate::solve::{SolveOptions, SolveReport, StopReason, proximal_weight};
+use crate::solve::{SolveOptions, SolveReport, StopReason, largest_vertex_move_m, proximal_weight, solve};
 
 /// Which rest-state procedure to run.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -208,11 +208,8 @@ pub fn relax(
         report.period_strain = [total[0] - 1.0, total[1] - 1.0];
     } else {
         let tile = RveModel::new(&current, yarn)?;
-        let (solved, state) = solve_at(&tile, &zero_strain(), None, &estimated_equilibrium_options(options));
+        let (solved, state) = flow_to_equilibrium(&tile, options)?;
         report.iterations += solved.iterations;
-        if !solved.converged {
-            return Err(not_converged("rest-shape estimation", &solved));
-        }
         current = configured(&current, &tile, &zero_strain(), &state);
     }
     centre(&mut current);
@@ -273,20 +270,45 @@ fn reset_solve_options(options: &RelaxOptions, tile: &RveModel) -> SolveOptions 
     }
 }
 
-/// Tolerance (A.33) of the estimation's last equilibrium, where the rods take the pre-tension
-/// that balances the contacts: tight enough that the solve ends in Newton's quadratic regime,
-/// not wherever a slow approach first crosses the default `1e-5`.
-const ESTIMATED_EQUILIBRIUM_TOLERANCE: f64 = 1e-7;
+/// Implicit gradient-flow steps of the estimation's last equilibrium at most.
+const MAX_FLOW_STEPS: usize = 400;
+/// The flow has settled once a step moves no vertex farther than this, in yarn radii; a plain
+/// Newton solve then finishes from there.
+const FLOW_SETTLED_RADII: f64 = 1e-3;
 
-/// The solve of the estimation's last equilibrium: from the last reset's configuration, which is
-/// collision-free, so without the cold start's strong early regularization (whose schedule
-/// makes the path, and on a soft tile the equilibrium reached, depend on the iteration count).
-fn estimated_equilibrium_options(options: &RelaxOptions) -> SolveOptions {
-    SolveOptions {
-        regularization: SolveOptions::warm_started().regularization,
-        tolerance: options.solve.tolerance.min(ESTIMATED_EQUILIBRIUM_TOLERANCE),
-        ..options.solve
+/// The estimation's last equilibrium, where the rods take the pre-tension that balances the
+/// contacts, as the end of the tile's implicit gradient flow from the last reset (the rule that
+/// picks among its equilibria): proximal steps as in the resets until a step moves no vertex
+/// farther than [`FLOW_SETTLED_RADII`] radii, then Newton to [`ESTIMATED_EQUILIBRIUM_TOLERANCE`].
+/// A single solve from the reset would crawl for thousands of iterations through the nearly
+/// flat landscape of a tile whose rods were just put at rest, and end where its step decisions
+/// lead.
+fn flow_to_equilibrium(
+    tile: &RveModel,
+    options: &RelaxOptions,
+) -> Result<(SolveReport, RveState), RelaxError> {
+    let place = placement(tile, &zero_strain());
+    let mut state = RveState::affine(tile, &place);
+    let warm = SolveOptions { regularization: SolveOptions::warm_started().regularization, ..options.solve };
+    let mut iterations = 0;
+    for _ in 0..MAX_FLOW_STEPS {
+        let before = state.g.clone();
+        let weight = proximal_weight(tile, &place, &state, REST_FLOW_STEP_RADII);
+        let step = solve(tile, &place, &mut state, &SolveOptions { proximal_weight: weight, ..warm });
+        iterations += step.iterations;
+        if !step.converged {
+            return Err(not_converged("rest-shape estimation (gradient flow)", &step));
+        }
+        if largest_vertex_move_m(tile, &(&state.g - before)) < FLOW_SETTLED_RADII * tile.radius_m {
+            break;
+        }
     }
+    let mut solved = solve(tile, &place, &mut state, &warm);
+    solved.iterations += iterations;
+    if !solved.converged {
+        return Err(not_converged("rest-shape estimation", &solved));
+    }
+    Ok((solved, state))
 }
 
 /// `pattern` moved to the tile's configuration `state` under the flat in-plane `strain`: the

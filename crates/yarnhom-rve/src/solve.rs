@@ -233,7 +233,8 @@ pub fn solve_observed(
     let residual = |gradient: &DVector<f64>| projected(&c, gradient).norm();
     let first = residual(&assemble(model, placement, &affine, &affine.g, Want::EnergyGradient).gradient)
         .max(force_floor(model));
-    let anchor = (options.proximal_weight > 0.0).then(|| Anchor::new(options.proximal_weight, &state.g, &scale));
+    let anchor =
+        (options.proximal_weight > 0.0).then(|| Anchor::new(options.proximal_weight, &state.g, &scale));
     let mut assembler = Assembler { model, placement, candidates: None, anchor };
     let mut current = assembler.assemble(state, &state.g, Want::DerivativesLower);
     let (reason, iterations) = 'solve: {
@@ -400,18 +401,27 @@ fn force_floor(model: &RveModel) -> f64 {
     model.material_law.stretch.density(1e-3).1 * (model.vertices as f64).sqrt()
 }
 
+/// Fraction of the force floor of (A.33) ([`force_floor`]) below which a proximal weight does
+/// not fall ([`proximal_weight`]).
+const PROXIMAL_FLOOR: f64 = 1.0;
+
 /// The proximal weight `μ` ([`SolveOptions::proximal_weight`]) whose step from `state` moves no
 /// scaled coordinate by more than `step_radii` yarn radii where the energy has no curvature:
-/// `μ = max(‖M ∇E‖∞, F₀) / (step_radii r)`, `F₀` the force floor of (A.33) ([`force_floor`]),
-/// so that a tile nearly in equilibrium is still anchored. A continuous function of the state
-/// and of the yarn's parameters.
-pub(crate) fn proximal_weight(model: &RveModel, placement: &Placement, state: &RveState, step_radii: f64) -> f64 {
+/// `μ = max(‖M ∇E‖∞, 10⁻³ F₀) / (step_radii r)`, `F₀` the force floor of (A.33), so that a
+/// tile nearly in equilibrium is still anchored. A continuous function of the state and of the
+/// yarn's parameters.
+pub(crate) fn proximal_weight(
+    model: &RveModel,
+    placement: &Placement,
+    state: &RveState,
+    step_radii: f64,
+) -> f64 {
     let r = model.radius_m;
     let gradient = assemble(model, placement, state, &state.g, Want::EnergyGradient).gradient;
     let largest = (0..gradient.len())
         .map(|i| gradient[i].abs() * if i < 3 * model.vertices { 1.0 } else { 1e6 * r })
         .fold(0.0, f64::max);
-    largest.max(force_floor(model)) / (step_radii * r)
+    largest.max(PROXIMAL_FLOOR * force_floor(model)) / (step_radii * r)
 }
 
 /// Relative diagonal shift of the Hessian in [`equilibrium_response`]: enough to factor a

@@ -183,7 +183,10 @@ fn a_proximal_solve_is_one_implicit_step_of_the_gradient_flow() {
         yarnhom_rve::assembly::Want::EnergyGradient,
     );
     let reported = (report.energy_j - tile.energy_j).abs();
-    assert!(reported < 1e-12 * tile.energy_j, "the reported energy is the tile's, without the anchor: {report:?}");
+    assert!(
+        reported < 1e-12 * tile.energy_j,
+        "the reported energy is the tile's, without the anchor: {report:?}"
+    );
     let r = model.radius_m;
     let pull = anchored.g.map_with_location(|i, _, g| {
         let inverse_square_scale = if i < 3 * model.vertices { 1.0 } else { (1e6 * r).powi(-2) };
