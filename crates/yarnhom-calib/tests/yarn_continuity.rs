@@ -95,3 +95,17 @@ fn the_objective_is_continuous_at_round_off_at_every_search_point() {
         }
     }
 }
+
+/// The objective is the same to the bit on one thread and on several: the rest-shape
+/// estimation is serial and the targets are solved in parallel into their own slots.
+#[test]
+fn the_objective_is_the_same_for_any_thread_count() {
+    let problem = stock_problem();
+    let targets = problem.targets(YarnFitSettings::default().swarm_targets).expect("shell targets");
+    let x = &points(&problem)[1];
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a pool");
+        pool.install(|| problem.evaluate(x, &targets).expect("evaluates").cost)
+    };
+    assert_eq!(on(1).to_bits(), on(3).to_bits());
+}
