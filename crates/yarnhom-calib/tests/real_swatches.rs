@@ -5,11 +5,17 @@
 #![cfg(feature = "hdf5")]
 
 use yarnhom_calib::cause::CauseId;
+use yarnhom_calib::data::set::PatternSource;
 use yarnhom_calib::data::stitch_by_stitch::import_fabric;
 use yarnhom_calib::diagnosis::diagnose;
 use yarnhom_calib::diagnosis::settings::DiagnoseSettings;
+use yarnhom_calib::optimize::swarm::SwarmSettings;
 use yarnhom_calib::shell::fit::{ShellFitSettings, fit_shell};
 use yarnhom_calib::shell::membrane::MembraneModel;
+use yarnhom_calib::yarn::fit::fit_yarn;
+use yarnhom_calib::yarn::params::YarnBasis;
+use yarnhom_calib::yarn::problem::YarnProblem;
+use yarnhom_calib::yarn::settings::YarnFitSettings;
 
 const DATA: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/stitch-by-stitch-acrylic");
 
@@ -93,6 +99,21 @@ const AUTHORS_RADII_M: [(&str, f64, f64); 4] = [
     ("seed", 1.20e-3, 0.285e-3),
 ];
 
+/// The yarn-level problem of the acrylic `pattern` set on the tile generated for its own
+/// stitch, from its shell fit, as `calibrate yarn` builds it.
+fn own_stitch_problem(pattern: &str, settings: &YarnFitSettings) -> YarnProblem {
+    let files = ["x", "y"].map(|d| format!("{DATA}/acrylic-{pattern}-{d}.h5").into());
+    let set = import_fabric(&files, 1).expect("imports").set;
+    let shell = fit_shell(&set, &ShellFitSettings::default()).expect("fits");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let tile = match set.fabric.pattern_source(dir.path()).expect("a generator") {
+        PatternSource::Generator(generator) => generator.generate().expect("generates"),
+        PatternSource::File(path) => panic!("a file {}", path.display()),
+    };
+    let basis = YarnBasis::of_set(&set, &tile, None);
+    YarnProblem::from_shell_fit(tile, basis, &shell, &set, settings).expect("a problem")
+}
+
 /// The yarn-level estimation (Sec. 6.5) of the four acrylic swatches on tiles generated for
 /// their own stitch, with the swarm and local budget of the validation table's reduced run
 /// (16 particles, 4 generations, 20 COBYLA evaluations): Fig. 6.15's errors per swatch and
@@ -102,13 +123,6 @@ const AUTHORS_RADII_M: [(&str, f64, f64); 4] = [
 #[test]
 #[ignore = "about 20 min on 2 cores: four yarn-level fits"]
 fn real_acrylic_swatches_at_yarn_level_on_their_own_stitch() {
-    use yarnhom_calib::data::set::PatternSource;
-    use yarnhom_calib::optimize::swarm::SwarmSettings;
-    use yarnhom_calib::yarn::fit::fit_yarn;
-    use yarnhom_calib::yarn::params::YarnBasis;
-    use yarnhom_calib::yarn::problem::YarnProblem;
-    use yarnhom_calib::yarn::settings::YarnFitSettings;
-
     let settings = YarnFitSettings {
         swarm: SwarmSettings { particles: 16, generations: 4, ..SwarmSettings::default() },
         local_budget: 20,
@@ -116,19 +130,9 @@ fn real_acrylic_swatches_at_yarn_level_on_their_own_stitch() {
     };
     let mut comfort = Vec::new();
     for (pattern, yarn_radius_m, core_radius_m) in AUTHORS_RADII_M {
-        let files = ["x", "y"].map(|d| format!("{DATA}/acrylic-{pattern}-{d}.h5").into());
-        let set = import_fabric(&files, 1).expect("imports").set;
-        let stitch = set.fabric.stitch.expect("the importer writes the authors' stitch");
+        let problem = own_stitch_problem(pattern, &settings);
+        let stitch = problem.basis.stitch.expect("the importer writes the authors' stitch");
         assert_eq!((stitch.yarn_radius_m, stitch.core_radius_m), (yarn_radius_m, Some(core_radius_m)));
-        let shell = fit_shell(&set, &ShellFitSettings::default()).expect("fits");
-        let dir = tempfile::tempdir().expect("tempdir");
-        let tile = match set.fabric.pattern_source(dir.path()).expect("a generator") {
-            PatternSource::Generator(generator) => generator.generate().expect("generates"),
-            PatternSource::File(path) => panic!("a file {}", path.display()),
-        };
-        let basis = YarnBasis::of_set(&set, &tile, None);
-        let vertices = tile.vertex_count();
-        let problem = YarnProblem::from_shell_fit(tile, basis, &shell, &set, &settings).expect("a problem");
         let fitted = fit_yarn(&problem, pattern, &settings, None, &|_| {}).expect("fits");
         let fit = &fitted.fit;
         let line: Vec<String> = fit
@@ -146,7 +150,8 @@ fn real_acrylic_swatches_at_yarn_level_on_their_own_stitch() {
             })
             .collect();
         eprintln!(
-            "{pattern} ({vertices} vertices): {}; R_1 {:.3} mm (yarn radius {:.3}), R_2 {:.3} mm (core {:.3}); g {:.4}; {:.0} s",
+            "{pattern} ({} vertices): {}; R_1 {:.3} mm (yarn radius {:.3}), R_2 {:.3} mm (core {:.3}); g {:.4}; {:.0} s",
+            problem.pattern.vertex_count(),
             line.join("; "),
             fit.params.r1_m * 1e3,
             yarn_radius_m * 1e3,
@@ -159,4 +164,32 @@ fn real_acrylic_swatches_at_yarn_level_on_their_own_stitch() {
     }
     let within = comfort.iter().filter(|e| **e <= 0.10).count();
     eprintln!("comfort error within 10% in {within} of {} swatch directions", comfort.len());
+}
+
+/// Issue 30's continuity at round-off on a slack generated tile: the acrylic stockinette's own
+/// stitch, the search fractions of `yarn_continuity.rs`, each coordinate scaled by `1 + 1e-12`.
+#[test]
+#[ignore = "fails: g moves by 1.1e-2, 9.7e-3, 6.7e-3 and 3.2e-9 relative at the four points: the last \
+            equilibrium of the rest-shape estimation and the compression of zero orthogonal stress are \
+            not unique on this slack tile (docs/validation.md)"]
+fn the_objective_on_the_generated_acrylic_stockinette_is_continuous_at_round_off() {
+    let problem = own_stitch_problem("stockinette", &YarnFitSettings::default());
+    let targets = problem.targets(YarnFitSettings::default().swarm_targets).expect("shell targets");
+    let fractions = [
+        [0.5, 0.5, 0.5, 0.5, 0.5, 0.5],
+        [0.2, 0.7, 0.4, 0.8, 0.3, 0.6],
+        [0.8, 0.3, 0.6, 0.9, 0.7, 0.4],
+        [0.5, 0.5, 0.7, 0.85, 0.5, 0.5],
+    ];
+    for f in fractions {
+        let x: Vec<f64> =
+            problem.basis.bounds().iter().zip(&f).map(|((lo, hi), t)| lo + t * (hi - lo)).collect();
+        let g = problem.evaluate(&x, &targets).expect("evaluates").cost;
+        for j in 0..x.len() {
+            let mut moved = x.clone();
+            moved[j] *= 1.0 + 1e-12;
+            let h = problem.evaluate(&moved, &targets).expect("evaluates").cost;
+            assert!(((h - g) / g).abs() < 1e-6, "at {x:?}, coordinate {j}: g {g} -> {h}");
+        }
+    }
 }
