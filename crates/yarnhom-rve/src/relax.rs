@@ -279,10 +279,10 @@ const FLOW_SETTLED_RADII: f64 = 1e-3;
 /// The estimation's last equilibrium, where the rods take the pre-tension that balances the
 /// contacts, as the end of the tile's implicit gradient flow from the last reset (the rule that
 /// picks among its equilibria): proximal steps as in the resets until a step moves no vertex
-/// farther than [`FLOW_SETTLED_RADII`] radii, then Newton to [`ESTIMATED_EQUILIBRIUM_TOLERANCE`].
-/// A single solve from the reset would crawl for thousands of iterations through the nearly
-/// flat landscape of a tile whose rods were just put at rest, and end where its step decisions
-/// lead.
+/// farther than [`FLOW_SETTLED_RADII`] radii, then a warm Newton solve. A cold solve from the
+/// reset crawls for hundreds of iterations under its regularization schedule through the nearly
+/// flat landscape of a tile whose rods were just put at rest, and ends where its step decisions
+/// lead. On slack tiles the final Newton solve can still crawl (docs/validation.md).
 fn flow_to_equilibrium(
     tile: &RveModel,
     options: &RelaxOptions,

@@ -401,15 +401,11 @@ fn force_floor(model: &RveModel) -> f64 {
     model.material_law.stretch.density(1e-3).1 * (model.vertices as f64).sqrt()
 }
 
-/// Fraction of the force floor of (A.33) ([`force_floor`]) below which a proximal weight does
-/// not fall ([`proximal_weight`]).
-const PROXIMAL_FLOOR: f64 = 1.0;
-
 /// The proximal weight `μ` ([`SolveOptions::proximal_weight`]) whose step from `state` moves no
 /// scaled coordinate by more than `step_radii` yarn radii where the energy has no curvature:
-/// `μ = max(‖M ∇E‖∞, 10⁻³ F₀) / (step_radii r)`, `F₀` the force floor of (A.33), so that a
-/// tile nearly in equilibrium is still anchored. A continuous function of the state and of the
-/// yarn's parameters.
+/// `μ = max(‖M ∇E‖∞, F₀) / (step_radii r)`, `F₀` the force floor of (A.33) ([`force_floor`]),
+/// so that a tile nearly in equilibrium is still anchored. A continuous function of the state
+/// and of the yarn's parameters.
 pub(crate) fn proximal_weight(
     model: &RveModel,
     placement: &Placement,
@@ -421,7 +417,7 @@ pub(crate) fn proximal_weight(
     let largest = (0..gradient.len())
         .map(|i| gradient[i].abs() * if i < 3 * model.vertices { 1.0 } else { 1e6 * r })
         .fold(0.0, f64::max);
-    largest.max(PROXIMAL_FLOOR * force_floor(model)) / (step_radii * r)
+    largest.max(force_floor(model)) / (step_radii * r)
 }
 
 /// Relative diagonal shift of the Hessian in [`equilibrium_response`]: enough to factor a
