@@ -343,7 +343,7 @@ impl Assembler<'_> {
         if let Some(anchor) = &self.anchor {
             assembled.energy_j += anchor.energy_j(g);
             if want != Want::Energy {
-                assembled.gradient += anchor.gradient(g);
+                anchor.add_gradient(g, &mut assembled.gradient);
             }
         }
         assembled
@@ -370,8 +370,11 @@ impl Anchor {
         0.5 * self.weight * d.component_mul(&d).dot(&self.inverse_square_scale)
     }
 
-    fn gradient(&self, g: &DVector<f64>) -> DVector<f64> {
-        (g - &self.at).component_mul(&self.inverse_square_scale) * self.weight
+    /// Add the anchor's gradient `μ M⁻²(g - g₀)` to `gradient` in place.
+    fn add_gradient(&self, g: &DVector<f64>, gradient: &mut DVector<f64>) {
+        for (i, out) in gradient.iter_mut().enumerate() {
+            *out += (g[i] - self.at[i]) * self.inverse_square_scale[i] * self.weight;
+        }
     }
 }
 
