@@ -54,10 +54,11 @@ fn real_acrylic_swatches_fit_and_diagnose() {
 
         let d = diagnose(&set, &DiagnoseSettings::default()).expect("diagnoses");
         eprintln!(
-            "  diagnosis: {} ({:.3} -> {:.3})",
+            "  diagnosis: {} ({:.3} -> {:.3}), {:.0} s",
             d.cause.id.as_str(),
             d.gain.heldout_error_before,
-            d.gain.heldout_error_after
+            d.gain.heldout_error_after,
+            d.wall_time_s
         );
         assert_ne!(
             d.cause.id,
@@ -192,4 +193,95 @@ fn the_objective_on_the_generated_acrylic_stockinette_is_continuous_at_round_off
             assert!(((h - g) / g).abs() < 1e-6, "at {x:?}, coordinate {j}: g {g} -> {h}");
         }
     }
+}
+
+/// Issue 30's comfort-range acceptance (six of eight directions within 10%) against the tiles
+/// the fabrics' own stitch gives: at `samples` search points spread over the whole Sec. 6.5.3
+/// box (a Halton sequence), the tile's weft and warp responses in the comfort range, each
+/// allowed one common stiffness scale (every energy scaled alike scales every stress alike and
+/// keeps every equilibrium, so the scale is free even beyond the box), and the smallest
+/// comfort error both directions reach at once. A swatch where that error stays above 10% at
+/// every point has at most one of its two directions within 10%.
+#[test]
+#[ignore = "about 15 min on 2 cores: 112 estimated rest shapes and their uniaxial tests"]
+fn the_own_stitch_tiles_fit_weft_and_warp_within_ten_percent_at_once_nowhere() {
+    let settings = YarnFitSettings::default();
+    let mut best_per_swatch = Vec::new();
+    for (pattern, samples) in [("stockinette", 40), ("garter", 40), ("rib", 16), ("seed", 16)] {
+        let problem = own_stitch_problem(pattern, &settings);
+        let targets = problem.targets(12).expect("shell targets");
+        let bounds = problem.basis.bounds();
+        let mut best = (f64::INFINITY, Vec::new(), [0.0; 2]);
+        for k in 1..=samples {
+            let x: Vec<f64> =
+                bounds.iter().enumerate().map(|(j, (lo, hi))| lo + halton(k, PRIMES[j]) * (hi - lo)).collect();
+            let Ok(evaluation) = problem.evaluate(&x, &targets) else { continue };
+            let (error, each) = common_scale_comfort_error(&targets, &evaluation.curves);
+            if error < best.0 {
+                best = (error, x, each);
+            }
+        }
+        eprintln!(
+            "{pattern}: smallest comfort error of weft and warp at once {:.1}% (weft {:.1}%, warp {:.1}%) at {:?}",
+            100.0 * best.0,
+            100.0 * best.2[0],
+            100.0 * best.2[1],
+            best.1
+        );
+        best_per_swatch.push(best.0);
+    }
+    let swatches_with_both = best_per_swatch.iter().filter(|e| **e <= 0.10).count();
+    assert!(
+        4 + swatches_with_both < 6,
+        "{swatches_with_both} swatches reach both directions within 10%: the acceptance is reachable"
+    );
+}
+
+const PRIMES: [usize; 8] = [2, 3, 5, 7, 11, 13, 17, 19];
+
+/// The `k`-th element of the van der Corput sequence in `base`.
+fn halton(mut k: usize, base: usize) -> f64 {
+    let (mut value, mut scale) = (0.0, 1.0);
+    while k > 0 {
+        scale /= base as f64;
+        value += scale * (k % base) as f64;
+        k /= base;
+    }
+    value
+}
+
+/// The smallest over one stiffness scale `a` of the larger of the two directions' comfort-range
+/// errors (Fig. 6.15's: RMS over the comfort targets of `(a σ - σ*) / (1 + s) / σ*_comfort`),
+/// and each direction's error at that scale.
+fn common_scale_comfort_error(
+    targets: &[yarnhom_calib::yarn::objective::DirectionTargets],
+    curves: &[yarnhom_calib::yarn::objective::SimulatedCurve],
+) -> (f64, [f64; 2]) {
+    let error_at = |a: f64| -> [f64; 2] {
+        let mut each = [0.0; 2];
+        for (e, (t, c)) in each.iter_mut().zip(targets.iter().zip(curves)) {
+            let comfort: Vec<f64> = (0..t.stretch.len())
+                .filter(|&i| t.stretch[i] <= t.comfort_stretch * (1.0 + 1e-9))
+                .map(|i| (a * c.stress_n_m[i] - t.stress_n_m[i]) / (1.0 + t.stretch[i]) / t.comfort_stress_n_m)
+                .collect();
+            *e = (comfort.iter().map(|r| r * r).sum::<f64>() / comfort.len().max(1) as f64).sqrt();
+        }
+        each
+    };
+    // Each error is convex in `a` (the root of a quadratic), so is the larger: a scan over
+    // twelve decades of `a`, then a halving pattern search, is plenty for a percentage.
+    let worst = |log_a: f64| error_at(10f64.powf(log_a)).into_iter().fold(0.0, f64::max);
+    let start = (0..=1200).map(|i| -6.0 + i as f64 * 0.01).min_by(|p, q| worst(*p).total_cmp(&worst(*q)));
+    let mut log_a = start.expect("a scan");
+    let mut step = 0.01;
+    while step > 1e-6 {
+        for candidate in [log_a - step, log_a + step] {
+            if worst(candidate) < worst(log_a) {
+                log_a = candidate;
+            }
+        }
+        step *= 0.5;
+    }
+    let each = error_at(10f64.powf(log_a));
+    (each[0].max(each[1]), each)
 }
