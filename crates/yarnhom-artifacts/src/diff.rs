@@ -14,6 +14,7 @@ use crate::grid::{Grid, GridSample, GridTerm};
 use crate::pattern::Pattern;
 use crate::rvesolve::RveSolve;
 use crate::spline::Spline;
+use crate::swatch::Swatch;
 use crate::yarnmodel::YarnModel;
 
 /// Tolerances of a comparison.
@@ -169,6 +170,15 @@ impl Diff {
         Diff { kind: kind.into(), structural: vec![], fields: vec![], notes: vec![] }
     }
 
+    /// Take in the findings of a nested comparison, its fields and findings prefixed.
+    fn merge(&mut self, prefix: &str, nested: Diff) {
+        self.structural.extend(nested.structural.into_iter().map(|s| format!("{prefix}{s}")));
+        self.notes.extend(nested.notes.into_iter().map(|s| format!("{prefix}{s}")));
+        self.fields.extend(
+            nested.fields.into_iter().map(|f| FieldDiff { field: format!("{prefix}{}", f.field), ..f }),
+        );
+    }
+
     /// Compare rows of numbers; a row's difference is the Euclidean norm of its element
     /// differences, and a row is outside tolerance if any element is.
     fn rows<const N: usize>(&mut self, field: &str, a: &[[f64; N]], b: &[[f64; N]], tol: Tolerance) {
@@ -249,6 +259,7 @@ pub fn diff(a: &AnyArtifact, b: &AnyArtifact, tol: Tolerance) -> Diff {
         (AnyArtifact::RveSolve(a), AnyArtifact::RveSolve(b)) => diff_rve_solves(a, b, tol),
         (AnyArtifact::Grid(a), AnyArtifact::Grid(b)) => diff_grids(a, b, tol),
         (AnyArtifact::Spline(a), AnyArtifact::Spline(b)) => diff_splines(a, b, tol),
+        (AnyArtifact::Swatch(a), AnyArtifact::Swatch(b)) => diff_swatches(a, b, tol),
         _ => {
             let mut d = Diff::new(a.kind());
             d.structural.push(format!("kinds differ: {} vs {}", a.kind(), b.kind()));
@@ -376,6 +387,57 @@ pub fn diff_patterns(a: &Pattern, b: &Pattern, tol: Tolerance) -> Diff {
             if x.is_some() { "first" } else { "second" }
         )),
     }
+    d
+}
+
+/// Compare two swatches: yarn ranges, sources and glue pairs exactly, then size, vertices,
+/// twists, radii, rest state and glue springs; the source pattern and the yarn model as
+/// [`diff_patterns`] and [`diff_yarn_models`] do, their fields prefixed `pattern.` and `model.`.
+pub fn diff_swatches(a: &Swatch, b: &Swatch, tol: Tolerance) -> Diff {
+    let mut d = Diff::new("swatch");
+    if a.name != b.name {
+        d.notes.push(format!("names differ: '{}' vs '{}'", a.name, b.name));
+    }
+    let topology = |s: &Swatch| -> Vec<(u32, u32, bool, u32)> {
+        s.yarns.iter().map(|y| (y.first_vertex, y.vertex_count, y.closed, y.source_yarn)).collect()
+    };
+    if a.yarns.len() != b.yarns.len() {
+        d.structural.push(format!("yarn count: {} vs {}", a.yarns.len(), b.yarns.len()));
+    } else if topology(a) != topology(b) {
+        d.structural.push("yarn ranges (first vertex, vertex count, closed, source yarn) differ".into());
+    }
+    if a.source_vertex != b.source_vertex || a.source_tile != b.source_tile {
+        d.structural.push("source vertices or tiles differ".into());
+    }
+    let pairs = |s: &Swatch| s.glue.iter().map(|g| g.vertices).collect::<Vec<_>>();
+    if pairs(a) != pairs(b) {
+        d.structural.push(format!(
+            "glue springs: {} vs {}, or joining other vertices",
+            a.glue.len(),
+            b.glue.len()
+        ));
+    }
+    if a.glue_settings != b.glue_settings {
+        d.notes.push(format!("glue settings differ: {:?} vs {:?}", a.glue_settings, b.glue_settings));
+    }
+    d.values("size_m", &a.size_m, &b.size_m, tol);
+    d.rows("positions_m", &a.positions_m, &b.positions_m, tol);
+    d.values("edge_twist_rad", &a.edge_twist_rad, &b.edge_twist_rad, tol);
+    if a.yarns.len() == b.yarns.len() {
+        let radii = |s: &Swatch| s.yarns.iter().map(|y| y.radius_m).collect::<Vec<_>>();
+        d.values("yarns.radius_m", &radii(a), &radii(b), tol);
+    }
+    d.values("rest_length_m", &a.rest_length_m, &b.rest_length_m, tol);
+    d.rows("reference_director", &a.reference_director, &b.reference_director, tol);
+    d.rows("rest_curvature", &a.rest_curvature, &b.rest_curvature, tol);
+    d.values("rest_twist_rad", &a.rest_twist_rad, &b.rest_twist_rad, tol);
+    d.values("reference_twist_rad", &a.reference_twist_rad, &b.reference_twist_rad, tol);
+    if a.glue.len() == b.glue.len() {
+        let glue = |s: &Swatch| s.glue.iter().map(|g| [g.rest_length_m, g.stiffness_n_m]).collect::<Vec<_>>();
+        d.rows("glue (rest_length_m, stiffness_n_m)", &glue(a), &glue(b), tol);
+    }
+    d.merge("pattern.", diff_patterns(&a.pattern, &b.pattern, tol));
+    d.merge("model.", diff_yarn_models(&a.model, &b.model, tol));
     d
 }
 

@@ -2,8 +2,8 @@
 //!
 //! `yarnhom convert --to hdf5` writes an artifact as an HDF5 file that any HDF5 reader (h5py,
 //! MATLAB, HDFView, ...) can open; [`import`] reads such a file back into the exact artifact. Only
-//! kinds made of arrays have a layout, today `pattern` and `grid`; a `yarnmodel` (a handful of
-//! scalars) is refused with [`Error::Unrepresentable`]: use JSON for it.
+//! kinds made of arrays have a layout, today `pattern`, `grid` and `swatch`; a `yarnmodel` (a
+//! handful of scalars) is refused with [`Error::Unrepresentable`]: use JSON for it.
 //!
 //! # Layout of a `pattern` (schema version 1)
 //!
@@ -67,6 +67,34 @@
 //! | `/samples/positions_m` | f64 `[n, V, 3]` | m | equilibrium vertices (optional) |
 //! | `/samples/edge_twist_rad` | f64 `[n, V]` | rad | equilibrium edge twists (with positions) |
 //!
+//! # Layout of a `swatch` (schema version 1)
+//!
+//! `N` vertices, `E` edges, `Y` yarns, `G` glue springs. Root attributes: those of a pattern from
+//! `yarnhom_kind` (`swatch`) to `inputs`, then `name`, `yarnmodel` (the yarn model's payload as
+//! JSON) and `glue_settings` (JSON: `reach_radii`, `pre_stretch`, `stiffness_n_m` or null).
+//! Datasets (with `units` and `description`):
+//!
+//! | dataset | type, shape | units | meaning |
+//! |---|---|---|---|
+//! | `/size_m` | f64 `[2]` | m | width and height of the cut rectangle |
+//! | `/vertices/position_m` | f64 `[N, 3]` | m | vertex positions, yarn after yarn |
+//! | `/vertices/source_vertex` | u32 `[N]` | 1 | pattern vertex each vertex copies |
+//! | `/vertices/source_tile` | i32 `[N, 2]` | 1 | tile `(i, j)` of the copy |
+//! | `/vertices/rest_curvature` | f64 `[N, 2]` | 1 | rest material curvature; zero at open ends |
+//! | `/vertices/rest_twist_rad` | f64 `[N]` | rad | rest twist; zero at open ends |
+//! | `/vertices/reference_twist_rad` | f64 `[N]` | rad | reference twist; zero at open ends |
+//! | `/edges/twist_rad` | f64 `[E]` | rad | material frame angle relative to the reference frame |
+//! | `/edges/rest_length_m` | f64 `[E]` | m | rest length |
+//! | `/edges/reference_director` | f64 `[E, 3]` | 1 | reference director d1 (unit) |
+//! | `/yarns/radius_m` | f64 `[Y]` | m | yarn radius |
+//! | `/yarns/first_vertex`, `/yarns/vertex_count` | u32 `[Y]` | 1 | each yarn's contiguous vertex range |
+//! | `/yarns/closed` | u8 `[Y]` | 1 | 1 for a closed yarn (`n` edges), 0 for an open one (`n - 1`) |
+//! | `/yarns/source_yarn` | u32 `[Y]` | 1 | pattern yarn it was cut from |
+//! | `/glue/vertices` | u32 `[G, 2]` | 1 | the vertices each glue spring joins (cut end first) |
+//! | `/glue/rest_length_m` | f64 `[G]` | m | glue spring rest length |
+//! | `/glue/stiffness_n_m` | f64 `[G]` | N/m | glue spring stiffness |
+//! | `/pattern/...` | | | the source pattern in the pattern layout above, its attributes `name`, `fabric`, `origin` on the group `/pattern` |
+//!
 //! # Choices
 //!
 //! - No chunking and no compression: a pattern is one periodic tile, a few hundred vertices in
@@ -92,10 +120,12 @@ use crate::container::{self, Header, InputRef, Producer};
 use crate::error::{Error, Result, ValidationError};
 use crate::grid::Grid;
 use crate::pattern::{Fabric, Pattern, RestState, Yarn};
+use crate::swatch::Swatch;
 use crate::{AnyArtifact, Artifact, AtomicFile};
 
 mod grid;
 pub mod layer;
+mod swatch;
 
 use layer::{Spec, create_group, describe, h5, write_str_attr, write_u32_attr};
 
@@ -184,6 +214,7 @@ pub fn export(path: &Path, header: &Header, artifact: &AnyArtifact) -> Result<()
     match artifact {
         AnyArtifact::Pattern(p) => export_as(path, header, p, write_pattern),
         AnyArtifact::Grid(g) => export_as(path, header, g, grid::write_grid),
+        AnyArtifact::Swatch(s) => export_as(path, header, s, swatch::write_swatch),
         AnyArtifact::YarnModel(_) => Err(Error::Unrepresentable {
             format: FORMAT,
             message: "a yarnmodel holds no arrays, so it has no HDF5 layout; use `--to json`".into(),
@@ -283,16 +314,30 @@ fn write_pattern(root: &Group, p: &Pattern) -> Result<()> {
     Ok(())
 }
 
+/// Write a dataset at `dataset.path` below `root` (the file's root, or a group such as a
+/// swatch's `/pattern`).
 fn write_dataset<T: H5Type>(root: &Group, dataset: &DatasetSpec, shape: &[usize], data: &[T]) -> Result<()> {
+    let path = located(root, dataset.path);
     let ds = root
         .new_dataset_builder()
         .obj_track_times(false)
         .empty::<T>()
         .shape(shape)
-        .create(dataset.path)
-        .map_err(|e| h5(format_args!("cannot create dataset {}", dataset.path), e))?;
-    ds.write_raw(data).map_err(|e| h5(format_args!("cannot write dataset {}", dataset.path), e))?;
+        .create(relative(dataset.path))
+        .map_err(|e| h5(format_args!("cannot create dataset {path}"), e))?;
+    ds.write_raw(data).map_err(|e| h5(format_args!("cannot write dataset {path}"), e))?;
     describe(&ds, &dataset.spec)
+}
+
+/// A layout path (`/a/b`) relative to the group it is written in (`a/b`).
+fn relative(path: &str) -> &str {
+    path.trim_start_matches('/')
+}
+
+/// The path a layout path has in the file when written below `group`: `/a/b` below the root,
+/// `/pattern/a/b` below `/pattern`.
+fn located(group: &Group, path: &str) -> String {
+    format!("{}{path}", group.name().trim_end_matches('/'))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -317,6 +362,10 @@ fn import_any(path: &Path) -> Result<(Header, AnyArtifact)> {
         k if k == Grid::KIND => {
             let (header, grid) = read_as(&file, grid::read_grid)?;
             Ok((header, AnyArtifact::Grid(grid)))
+        }
+        k if k == Swatch::KIND => {
+            let (header, swatch) = read_as(&file, swatch::read_swatch)?;
+            Ok((header, AnyArtifact::Swatch(swatch)))
         }
         k if crate::KINDS.contains(&k) => Err(Error::Hdf5(format!(
             "root attribute '{KIND_ATTR}' names kind '{k}', which has no HDF5 layout"
@@ -380,7 +429,8 @@ fn read_pattern(root: &Group) -> Result<Pattern> {
         "woven" => Fabric::Woven,
         other => {
             return Err(Error::Hdf5(format!(
-                "root attribute 'fabric' must be 'knit' or 'woven', found '{other}'"
+                "{} must be 'knit' or 'woven', found '{other}'",
+                attr_label(root, "fabric")
             )));
         }
     };
@@ -474,11 +524,11 @@ fn rows<T: Copy, const N: usize>(flat: Vec<T>) -> Vec<[T; N]> {
     flat.chunks_exact(N).map(|c| std::array::from_fn(|i| c[i])).collect()
 }
 
-/// Does `path` (absolute, `/a/b`) name a link in the file? Checks each level, as HDF5 refuses
-/// to look below a missing group.
+/// Does the layout path `path` (`/a/b`) name a link below `root`? Checks each level, as HDF5
+/// refuses to look below a missing group.
 fn exists(root: &Group, path: &str) -> bool {
     let mut prefix = String::new();
-    path.trim_start_matches('/').split('/').all(|part| {
+    relative(path).split('/').all(|part| {
         if !prefix.is_empty() {
             prefix.push('/');
         }
@@ -494,58 +544,66 @@ fn read_dataset<T: H5Type>(
     spec: &DatasetSpec,
     expected: &[Option<usize>],
 ) -> Result<(Vec<T>, Vec<usize>)> {
+    let path = located(root, spec.path);
     if !exists(root, spec.path) {
-        return Err(Error::Hdf5(format!("missing dataset {}", spec.path)));
+        return Err(Error::Hdf5(format!("missing dataset {path}")));
     }
     let ds: Dataset = root
-        .dataset(spec.path)
-        .map_err(|e| h5(format_args!("{} is not a readable dataset", spec.path), e))?;
+        .dataset(relative(spec.path))
+        .map_err(|e| h5(format_args!("{path} is not a readable dataset"), e))?;
     let found = ds
         .dtype()
         .and_then(|t| t.to_descriptor())
-        .map_err(|e| h5(format_args!("dataset {}: unreadable dtype", spec.path), e))?;
+        .map_err(|e| h5(format_args!("dataset {path}: unreadable dtype"), e))?;
     let want = T::type_descriptor();
     if found != want {
-        return Err(Error::Hdf5(format!("dataset {} has dtype {found}, expected {want}", spec.path)));
+        return Err(Error::Hdf5(format!("dataset {path} has dtype {found}, expected {want}")));
     }
-    let shape = ds.get_shape().map_err(|e| h5(format_args!("dataset {}: unreadable shape", spec.path), e))?;
+    let shape = ds.get_shape().map_err(|e| h5(format_args!("dataset {path}: unreadable shape"), e))?;
     let fits =
         shape.len() == expected.len() && shape.iter().zip(expected).all(|(&s, e)| e.is_none_or(|e| e == s));
     if !fits {
         let want: Vec<String> =
             expected.iter().map(|e| e.map_or("any".to_string(), |e| e.to_string())).collect();
         return Err(Error::Hdf5(format!(
-            "dataset {} has shape {shape:?}, expected [{}]",
-            spec.path,
+            "dataset {path} has shape {shape:?}, expected [{}]",
             want.join(", ")
         )));
     }
-    let data = ds.read_raw::<T>().map_err(|e| h5(format_args!("cannot read dataset {}", spec.path), e))?;
+    let data = ds.read_raw::<T>().map_err(|e| h5(format_args!("cannot read dataset {path}"), e))?;
     if data.len() != shape.iter().product::<usize>() {
-        return Err(Error::Hdf5(format!(
-            "dataset {}: read {} values for shape {shape:?}",
-            spec.path,
-            data.len()
-        )));
+        return Err(Error::Hdf5(format!("dataset {path}: read {} values for shape {shape:?}", data.len())));
     }
     Ok((data, shape))
 }
 
 fn has_attr(loc: &Location, name: &str) -> Result<bool> {
-    let names = loc.attr_names().map_err(|e| h5("cannot list the root attributes", e))?;
+    let names =
+        loc.attr_names().map_err(|e| h5(format_args!("cannot list the attributes of {}", loc.name()), e))?;
     Ok(names.iter().any(|a| a == name))
 }
 
-fn open_attr(loc: &Location, name: &str) -> Result<::hdf5::Attribute> {
-    if !has_attr(loc, name)? {
-        return Err(Error::Hdf5(format!("missing root attribute '{name}'")));
+/// An attribute as errors name it: `root attribute 'x'`, or `attribute 'x' of /pattern` below
+/// the root.
+fn attr_label(loc: &Location, name: &str) -> String {
+    match loc.name().as_str() {
+        "/" => format!("root attribute '{name}'"),
+        group => format!("attribute '{name}' of {group}"),
     }
-    loc.attr(name).map_err(|e| h5(format_args!("cannot open root attribute '{name}'"), e))
+}
+
+fn open_attr(loc: &Location, name: &str) -> Result<::hdf5::Attribute> {
+    let label = attr_label(loc, name);
+    if !has_attr(loc, name)? {
+        return Err(Error::Hdf5(format!("missing {label}")));
+    }
+    loc.attr(name).map_err(|e| h5(format_args!("cannot open {label}"), e))
 }
 
 fn read_str_attr(loc: &Location, name: &str) -> Result<String> {
     let attr = open_attr(loc, name)?;
-    let err = |e| h5(format_args!("cannot read root attribute '{name}'"), e);
+    let label = attr_label(loc, name);
+    let err = |e| h5(format_args!("cannot read {label}"), e);
     match attr.dtype().and_then(|t| t.to_descriptor()).map_err(err)? {
         TypeDescriptor::VarLenUnicode => {
             attr.read_scalar::<VarLenUnicode>().map(|s| s.as_str().to_owned()).map_err(err)
@@ -553,23 +611,21 @@ fn read_str_attr(loc: &Location, name: &str) -> Result<String> {
         TypeDescriptor::VarLenAscii => {
             attr.read_scalar::<VarLenAscii>().map(|s| s.as_str().to_owned()).map_err(err)
         }
-        other => Err(Error::Hdf5(format!(
-            "root attribute '{name}' has type {other}, expected a variable-length string"
-        ))),
+        other => Err(Error::Hdf5(format!("{label} has type {other}, expected a variable-length string"))),
     }
 }
 
 fn read_u32_attr(loc: &Location, name: &str) -> Result<u32> {
     let attr = open_attr(loc, name)?;
-    let err = |e| h5(format_args!("cannot read root attribute '{name}'"), e);
+    let label = attr_label(loc, name);
+    let err = |e| h5(format_args!("cannot read {label}"), e);
     match attr.dtype().and_then(|t| t.to_descriptor()).map_err(err)? {
         TypeDescriptor::Integer(_) | TypeDescriptor::Unsigned(_) => {
             let v = attr.read_scalar::<i64>().map_err(err)?;
-            u32::try_from(v).map_err(|_| {
-                Error::Hdf5(format!("root attribute '{name}' is {v}, expected an unsigned 32-bit integer"))
-            })
+            u32::try_from(v)
+                .map_err(|_| Error::Hdf5(format!("{label} is {v}, expected an unsigned 32-bit integer")))
         }
-        other => Err(Error::Hdf5(format!("root attribute '{name}' has type {other}, expected an integer"))),
+        other => Err(Error::Hdf5(format!("{label} has type {other}, expected an integer"))),
     }
 }
 

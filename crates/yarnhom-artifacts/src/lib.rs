@@ -17,6 +17,7 @@ pub mod report;
 pub mod rvesolve;
 pub mod schema;
 pub mod spline;
+pub mod swatch;
 pub mod yarnmodel;
 
 use serde::{Deserialize, Serialize, de::DeserializeOwned};
@@ -28,6 +29,7 @@ pub use grid::{Grid, GridSample, GridShard, GridTerm, MergeError};
 pub use pattern::{Fabric, Pattern, RestState, Yarn};
 pub use rvesolve::{RveSolve, StrainSample};
 pub use spline::{AxisLimit, BicubicTerm, CubicTerm, FitSettings, Spline, SplineOrigin};
+pub use swatch::{GlueSettings, GlueSpring, Swatch, SwatchYarn};
 pub use yarnmodel::{YarnMechanics, YarnModel};
 
 /// A kind of artifact: a serde type with a name, a schema version, invariants and migrations.
@@ -83,6 +85,8 @@ pub struct JsonDocument {
 macro_rules! artifact_kinds {
     ($($variant:ident => $ty:ty),+ $(,)?) => {
         /// A decoded artifact of any kind.
+        // One value per file, moved out at once: the size of the largest kind costs nothing.
+        #[allow(clippy::large_enum_variant)]
         #[derive(Debug, Clone, PartialEq)]
         pub enum AnyArtifact {
             $(
@@ -186,12 +190,24 @@ impl Artifact for Grid {
     }
 }
 
+impl Artifact for Swatch {
+    const KIND: &'static str = "swatch";
+    const SCHEMA_VERSION: u32 = 1;
+    fn validate(&self) -> std::result::Result<(), ValidationError> {
+        Swatch::validate(self)
+    }
+    fn summary(&self) -> String {
+        Swatch::summary(self)
+    }
+}
+
 artifact_kinds! {
     Pattern => Pattern,
     YarnModel => YarnModel,
     RveSolve => RveSolve,
     Grid => Grid,
     Spline => Spline,
+    Swatch => Swatch,
 }
 
 impl AnyArtifact {

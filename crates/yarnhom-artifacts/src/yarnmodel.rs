@@ -131,6 +131,18 @@ impl YarnModel {
         out
     }
 
+    /// The small-strain stretch stiffness of the yarn, force per unit strain (N): `E π r²` for
+    /// an elastic rod (as `yarnhom-rod` builds it), the low-stretch stiffness `k_s1` of (6.5)
+    /// for the biphasic model.
+    pub fn stretch_stiffness_n(&self) -> f64 {
+        match self.mechanics {
+            YarnMechanics::ElasticRod { youngs_modulus_pa, .. } => {
+                youngs_modulus_pa * std::f64::consts::PI * self.radius_m * self.radius_m
+            }
+            YarnMechanics::Biphasic { k_s1_n, .. } => k_s1_n,
+        }
+    }
+
     /// Check that every parameter is physical.
     pub fn validate(&self) -> Result<(), ValidationError> {
         for (name, value) in self.parameters() {
@@ -220,5 +232,31 @@ impl From<YarnModelV0> for YarnModel {
                 contact_stiffness_kg_s2: v0.k_contact,
             },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stretch_stiffness_is_the_axial_stiffness_of_each_family() {
+        let stock = YarnModel::table_4_1("stock").expect("a Table 4.1 row");
+        // E pi r^2 with E = 5e5 Pa and r = 1 mm.
+        assert!((stock.stretch_stiffness_n() - 5e5 * std::f64::consts::PI * 1e-6).abs() < 1e-12);
+        let biphasic = YarnModel {
+            mechanics: YarnMechanics::Biphasic {
+                k_s1_n: 2.5,
+                k_s2_n: 40.0,
+                eps_bar: 0.05,
+                k_b_nm2: 1e-6,
+                r1_m: 1e-3,
+                k_c1_n_m: 10.0,
+                r2_m: 5e-4,
+                k_c2_n_m: 100.0,
+            },
+            ..stock
+        };
+        assert_eq!(biphasic.stretch_stiffness_n(), 2.5);
     }
 }

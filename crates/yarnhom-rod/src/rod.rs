@@ -47,47 +47,145 @@ pub struct Rod {
 /// Energy, gradient and Hessian triplets `(row, column, value)` (duplicates to be summed).
 pub type Assembled = (f64, DVector<f64>, Vec<(usize, usize, f64)>);
 
+/// The rest state of a rod given explicitly ([`Rod::with_rest_shape`]): per edge, per bend
+/// vertex ([`Rod::bend_vertex_range`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RestShape {
+    /// Rest length of every edge (m).
+    pub rest_lengths_m: Vec<f64>,
+    /// First reference director of every edge.
+    pub reference_directors: Vec<[f64; 3]>,
+    /// Rest material curvature `κ̄` of every bend vertex.
+    pub rest_curvature: Vec<[f64; 2]>,
+    /// Rest twist `m̄` of every bend vertex (rad).
+    pub rest_twist_rad: Vec<f64>,
+    /// Reference twist of every bend vertex at the rod's configuration (rad).
+    pub reference_twist_rad: Vec<f64>,
+}
+
+impl RestShape {
+    /// The rest shape read off `positions` (twist angles zero): rest lengths the edge lengths,
+    /// reference directors as close to `director_hint` as the first edge allows and parallel
+    /// transported along the rod, rest curvature and twist those of the configuration.
+    pub fn of(positions: &[[f64; 3]], closed: bool, director_hint: [f64; 3]) -> RestShape {
+        let vertices = positions.len();
+        let edges = if closed { vertices } else { vertices.saturating_sub(1) };
+        let mut chained: Vec<EdgeFrame> = Vec::with_capacity(edges);
+        for e in 0..edges {
+            let vector = edge_vector(positions, e);
+            let frame =
+                chained.last().map_or_else(|| EdgeFrame::new(vector, director_hint), |f| f.updated(vector));
+            chained.push(frame);
+        }
+        let reference_directors: Vec<[f64; 3]> = chained.iter().map(|f| f.director).collect();
+        let frames = edge_frames(positions, &reference_directors);
+        let (mut rest_curvature, mut rest_twist_rad) = (vec![], vec![]);
+        for v in Rod::bend_vertex_range(vertices, closed) {
+            let (e_in, e_out) = ((v + edges - 1) % edges, v % edges);
+            let reference =
+                BendTwistReference { frames: [frames[e_in], frames[e_out]], reference_twist_rad: 0.0 };
+            let (prev, next) = (positions[(v + vertices - 1) % vertices], positions[(v + 1) % vertices]);
+            let local: [f64; 11] = std::array::from_fn(|i| match i {
+                0..3 => prev[i],
+                3..6 => positions[v][i - 3],
+                6..9 => next[i - 6],
+                _ => 0.0,
+            });
+            let (kappa, twist) = curvature_and_twist(&reference, &local);
+            rest_curvature.push(kappa);
+            rest_twist_rad.push(twist);
+        }
+        RestShape {
+            rest_lengths_m: (0..edges).map(|e| Vector3::from(edge_vector(positions, e)).norm()).collect(),
+            reference_directors,
+            reference_twist_rad: rest_twist_rad.clone(),
+            rest_curvature,
+            rest_twist_rad,
+        }
+    }
+}
+
+/// The vector of edge `e` of the rod through `positions` (closed or not: `e + 1` wraps).
+fn edge_vector(positions: &[[f64; 3]], e: usize) -> [f64; 3] {
+    let (a, b) = (positions[e], positions[(e + 1) % positions.len()]);
+    [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+}
+
+/// The reference frame of every edge with first director `directors[e]` (projected onto its
+/// normal plane).
+fn edge_frames(positions: &[[f64; 3]], directors: &[[f64; 3]]) -> Vec<EdgeFrame> {
+    directors.iter().enumerate().map(|(e, &d)| EdgeFrame::new(edge_vector(positions, e), d)).collect()
+}
+
 impl Rod {
     /// A rod through `positions` whose rest shape is that configuration (rest lengths,
     /// curvatures and twists read off it, twist angles zero): it is in equilibrium there.
     /// Reference directors start as close to `director_hint` as each edge allows and are
-    /// parallel transported along the rod.
+    /// parallel transported along the rod. The rod of [`Rod::with_rest_shape`] fed with
+    /// [`RestShape::of`].
     pub fn at_rest(
         positions: &[[f64; 3]],
         closed: bool,
         material: RodMaterial,
         director_hint: [f64; 3],
     ) -> Rod {
+        Rod::with_rest_shape(positions, closed, material, RestShape::of(positions, closed, director_hint))
+    }
+
+    /// A rod through `positions` (twist angles zero) with the explicit rest shape `rest`: rest
+    /// lengths per edge, reference directors per edge (each projected onto its edge's normal plane
+    /// at `positions`, as [`EdgeFrame::new`] does), and per bend vertex
+    /// ([`Rod::bend_vertex_range`]) the rest curvature and twist and the reference twist at
+    /// `positions`.
+    ///
+    /// # Panics
+    /// If the lengths of `rest`'s lists disagree with the rod's edges and bend vertices.
+    pub fn with_rest_shape(
+        positions: &[[f64; 3]],
+        closed: bool,
+        material: RodMaterial,
+        rest: RestShape,
+    ) -> Rod {
         let vertices = positions.len();
-        let edges = if closed { vertices } else { vertices - 1 };
-        let edge = |i: usize| {
-            let (a, b) = (positions[i], positions[(i + 1) % vertices]);
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]]
+        let edges = rest.rest_lengths_m.len();
+        let bends = Rod::bend_vertex_range(vertices, closed).len();
+        assert!(
+            edges == if closed { vertices } else { vertices.saturating_sub(1) }
+                && rest.reference_directors.len() == edges
+                && [rest.rest_curvature.len(), rest.rest_twist_rad.len(), rest.reference_twist_rad.len()]
+                    == [bends; 3],
+            "rest shape of {edges} edges and {bends} bend vertices for a rod of {vertices} vertices"
+        );
+        let frames = edge_frames(positions, &rest.reference_directors);
+        let mut rod = Rod {
+            closed,
+            vertices,
+            material,
+            rest_lengths: rest.rest_lengths_m,
+            elements: vec![],
+            references: vec![],
         };
-        let mut frames = vec![EdgeFrame::new(edge(0), director_hint)];
-        for i in 1..edges {
-            let previous = frames[i - 1];
-            frames.push(previous.updated(edge(i)));
-        }
-        let rest_lengths: Vec<f64> = (0..edges).map(|i| Vector3::from(edge(i)).norm()).collect();
-        let mut rod = Rod { closed, vertices, material, rest_lengths, elements: vec![], references: vec![] };
-        let q = rod.dofs_of(positions, &vec![0.0; edges]);
         let bend_vertices: Vec<(usize, usize, usize)> = rod.bend_vertices().collect();
-        for (v, e_in, e_out) in bend_vertices {
-            let reference =
-                BendTwistReference { frames: [frames[e_in], frames[e_out]], reference_twist_rad: 0.0 };
-            let local = rod.element_dofs(&q, v, e_in, e_out);
-            let (kappa, twist) = curvature_and_twist(&reference, &std::array::from_fn(|i| local[i]));
-            rod.references.push(BendTwistReference { reference_twist_rad: twist, ..reference });
+        for (k, (_, e_in, e_out)) in bend_vertices.into_iter().enumerate() {
+            rod.references.push(BendTwistReference {
+                frames: [frames[e_in], frames[e_out]],
+                reference_twist_rad: rest.reference_twist_rad[k],
+            });
             rod.elements.push(BendTwist {
                 bend_stiffness_nm2: material.bend_stiffness_nm2,
                 twist_stiffness_nm2: material.twist_stiffness_nm2,
-                rest_curvature: kappa,
-                rest_twist_rad: twist,
+                rest_curvature: rest.rest_curvature[k],
+                rest_twist_rad: rest.rest_twist_rad[k],
                 rest_length_sum_m: rod.rest_lengths[e_in] + rod.rest_lengths[e_out],
             });
         }
         rod
+    }
+
+    /// The bend vertices of a rod of `vertices` vertices, in the order of the per-bend-vertex
+    /// lists of [`RestShape`]: `1..n-1` for an open rod, `0..n` for a closed one.
+    pub fn bend_vertex_range(vertices: usize, closed: bool) -> std::ops::Range<usize> {
+        if closed { 0..vertices } else { 1..vertices.saturating_sub(1).max(1) }
     }
 
     /// The same rod with a straight, untwisted rest shape (rest lengths kept).
@@ -118,9 +216,8 @@ impl Rod {
 
     /// `(vertex, incoming edge, outgoing edge)` of every bending-twisting element.
     fn bend_vertices(&self) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
-        let (n, m) = (self.vertices, self.edge_count());
-        let range = if self.closed { 0..n } else { 1..n - 1 };
-        range.map(move |v| (v, (v + m - 1) % m, v % m))
+        let m = self.edge_count();
+        Rod::bend_vertex_range(self.vertices, self.closed).map(move |v| (v, (v + m - 1) % m, v % m))
     }
 
     /// Global DOF indices of an element `(x_prev, x_v, x_next, θ_in, θ_out)`.
@@ -208,5 +305,102 @@ impl Rod {
             })
             .collect();
         self.references = updated;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::stretch::StretchLaw;
+
+    fn material() -> RodMaterial {
+        RodMaterial {
+            stretch: StretchLaw::Linear { k_n: 100.0 },
+            bend_stiffness_nm2: [2.0, 3.0],
+            twist_stiffness_nm2: 1.5,
+        }
+    }
+
+    fn helix(n: usize) -> Vec<[f64; 3]> {
+        (0..n).map(|i| 0.3 * i as f64).map(|s| [s.cos(), s.sin(), 0.2 * s]).collect()
+    }
+
+    /// The rest data of the rod through `p`, read off with the public pieces alone: edge lengths,
+    /// reference directors parallel transported from `hint`, and the curvature and twist of
+    /// every bend vertex in the frames those directors give.
+    fn rest_data_read_off(p: &[[f64; 3]], closed: bool, hint: [f64; 3]) -> RestShape {
+        let n = p.len();
+        let m = if closed { n } else { n - 1 };
+        let edge = |e: usize| -> [f64; 3] { std::array::from_fn(|k| p[(e + 1) % n][k] - p[e][k]) };
+        let mut transported = vec![EdgeFrame::new(edge(0), hint)];
+        for e in 1..m {
+            transported.push(transported[e - 1].updated(edge(e)));
+        }
+        let directors: Vec<[f64; 3]> = transported.iter().map(|f| f.director).collect();
+        let frames: Vec<EdgeFrame> = (0..m).map(|e| EdgeFrame::new(edge(e), directors[e])).collect();
+        let bends = if closed { 0..n } else { 1..n - 1 };
+        let (kappa, twist): (Vec<[f64; 2]>, Vec<f64>) = bends
+            .map(|v| {
+                let (e_in, e_out) = ((v + m - 1) % m, v % m);
+                let reference =
+                    BendTwistReference { frames: [frames[e_in], frames[e_out]], reference_twist_rad: 0.0 };
+                let points = [p[(v + n - 1) % n], p[v], p[(v + 1) % n]];
+                let q: [f64; 11] = std::array::from_fn(|i| if i < 9 { points[i / 3][i % 3] } else { 0.0 });
+                curvature_and_twist(&reference, &q)
+            })
+            .unzip();
+        RestShape {
+            rest_lengths_m: (0..m).map(|e| Vector3::from(edge(e)).norm()).collect(),
+            reference_directors: directors,
+            rest_curvature: kappa,
+            reference_twist_rad: twist.clone(),
+            rest_twist_rad: twist,
+        }
+    }
+
+    #[test]
+    fn at_rest_is_the_explicit_constructor_fed_with_the_rest_data_read_off_the_positions() {
+        let hint = [0.2, -0.4, 1.0];
+        for (positions, closed) in [(helix(17), false), (helix(12), true)] {
+            let rest = rest_data_read_off(&positions, closed, hint);
+            let explicit = Rod::with_rest_shape(&positions, closed, material(), rest.clone());
+            assert_eq!(Rod::at_rest(&positions, closed, material(), hint), explicit);
+            assert_eq!(RestShape::of(&positions, closed, hint), rest);
+            // A straight rest shape given explicitly is the straightened rod.
+            let bends = Rod::bend_vertex_range(positions.len(), closed).len();
+            let straight =
+                RestShape { rest_curvature: vec![[0.0; 2]; bends], rest_twist_rad: vec![0.0; bends], ..rest };
+            assert_eq!(
+                Rod::with_rest_shape(&positions, closed, material(), straight),
+                Rod::at_rest(&positions, closed, material(), hint).with_straight_rest_shape()
+            );
+        }
+    }
+
+    #[test]
+    fn a_straight_rod_with_an_explicit_curved_rest_shape_stores_the_energy_of_its_curvature() {
+        // Straight and untwisted, its curvature and twist are zero, so every bend vertex stores
+        // (α1 κ̄1² + α2 κ̄2² + β m̄²) / (L̄_in + L̄_out) of the rest data given.
+        let positions: Vec<[f64; 3]> = (0..9).map(|i| [0.25 * i as f64, 0.0, 0.0]).collect();
+        let bends = Rod::bend_vertex_range(9, false).len();
+        let rest = RestShape {
+            rest_lengths_m: (0..8).map(|e| 0.2 + 0.01 * e as f64).collect(),
+            reference_directors: vec![[0.0, 1.0, 0.0]; 8],
+            rest_curvature: (0..bends).map(|k| [0.1 * k as f64, -0.05 * k as f64]).collect(),
+            rest_twist_rad: (0..bends).map(|k| 0.02 * k as f64).collect(),
+            reference_twist_rad: vec![0.0; bends],
+        };
+        let expected: f64 = (0..bends)
+            .map(|k| {
+                let ([k1, k2], m) = (rest.rest_curvature[k], rest.rest_twist_rad[k]);
+                (2.0 * k1 * k1 + 3.0 * k2 * k2 + 1.5 * m * m)
+                    / (rest.rest_lengths_m[k] + rest.rest_lengths_m[k + 1])
+            })
+            .sum();
+        let stretch: f64 =
+            rest.rest_lengths_m.iter().map(|&l| 0.5 * 100.0 * (0.25 / l - 1.0).powi(2) * l).sum();
+        let rod = Rod::with_rest_shape(&positions, false, material(), rest);
+        let (energy, _, _) = rod.assemble(&rod.dofs_of(&positions, &[0.0; 8]));
+        assert!((energy - expected - stretch).abs() < 1e-12 * energy, "{energy} vs {}", expected + stretch);
     }
 }

@@ -1,10 +1,10 @@
 //! The tile's elements and rest state, from a pattern (with rest state) and a yarn model.
 
 use nalgebra::Vector3;
-use yarnhom_artifacts::{Pattern, YarnMechanics, YarnModel};
+use yarnhom_artifacts::{Pattern, YarnModel};
 use yarnhom_geom::segment_distance;
 use yarnhom_pattern::YarnNeighbours;
-use yarnhom_rod::{BendTwist, ContactLaw, RodMaterial, StretchLaw};
+use yarnhom_rod::{BendTwist, ContactLaw, RodMaterial, rod_laws};
 
 use crate::placement::Instance;
 
@@ -241,28 +241,6 @@ pub fn material_edge(material: &[Vector3<f64>], period_m: [f64; 2], s: &StretchE
         Vector3::new(f64::from(i.image[0]) * period_m[0], f64::from(i.image[1]) * period_m[1], 0.0)
     };
     material[s.to.vertex as usize] + offset(s.to) - material[s.from.vertex as usize] - offset(s.from)
-}
-
-/// The rod and contact laws of a yarn model: Table 4.1's elastic rods with Kaldor contact
-/// (Ch. 3-5), or the Ch. 6 model: biphasic stretch (6.5), isotropic bending without twisting
-/// stiffness (6.6) and the two-phase contact barrier (6.7).
-fn rod_laws(model: &YarnModel) -> (RodMaterial, ContactLaw) {
-    match model.mechanics {
-        YarnMechanics::ElasticRod { youngs_modulus_pa, shear_modulus_pa, gamma, contact_stiffness_kg_s2 } => {
-            (
-                RodMaterial::circular(youngs_modulus_pa, shear_modulus_pa, gamma, model.radius_m),
-                ContactLaw::Kaldor { stiffness: contact_stiffness_kg_s2, radius_m: model.radius_m },
-            )
-        }
-        YarnMechanics::Biphasic { k_s1_n, k_s2_n, eps_bar, k_b_nm2, r1_m, k_c1_n_m, r2_m, k_c2_n_m } => (
-            RodMaterial {
-                stretch: StretchLaw::Biphasic { k_s1_n, k_s2_n, eps_bar },
-                bend_stiffness_nm2: [k_b_nm2; 2],
-                twist_stiffness_nm2: 0.0,
-            },
-            ContactLaw::TwoPhase { outer: (r1_m, k_c1_n_m), inner: (r2_m, k_c2_n_m) },
-        ),
-    }
 }
 
 /// Image offsets `o` for which some edge of the tile image `o` may come within `reach` of an

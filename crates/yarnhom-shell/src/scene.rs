@@ -223,7 +223,12 @@ impl Scene {
 
     /// The handles over `mesh` with their motions; errors if a handle holds no vertex.
     pub fn handles(&self, mesh: &ShellMesh) -> Result<Vec<Handle>, SceneError> {
-        let positions = mesh.flat_positions();
+        self.handles_at(&mesh.flat_positions())
+    }
+
+    /// The handles over vertices at rest `positions` (the cloth's rectangle of `size_m`
+    /// centred on the origin) with their motions; errors if a handle holds no vertex.
+    pub fn handles_at(&self, positions: &[Vector3<f64>]) -> Result<Vec<Handle>, SceneError> {
         self.handles
             .iter()
             .enumerate()

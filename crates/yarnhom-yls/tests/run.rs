@@ -1,0 +1,123 @@
+//! The shell simulator's scenes run on swatches of the published stockinette: handles grip
+//! the yarns the scene names, obstacles become barriers, the frames are recorded, and nothing
+//! crosses.
+
+use yarnhom_artifacts::{GlueSettings, Swatch, YarnModel, pyp};
+use yarnhom_trace::{TraceMessage, TraceMetadata, TraceReader, TraceSink};
+use yarnhom_yls::dynamics::Simulation;
+use yarnhom_yls::record::record_frame;
+use yarnhom_yls::run::{RunError, RunSettings, place, run};
+use yarnhom_yls::swatch::{SwatchSize, cut_swatch};
+
+fn stock_swatch(tiles: [u32; 2]) -> Swatch {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-patterns/stock.pyp");
+    let text = std::fs::read_to_string(path).expect("the published stockinette");
+    let pattern = pyp::parse_pyp(&text, "stock", None).expect("a valid .pyp");
+    let model = YarnModel::table_4_1("stock").expect("a Table 4.1 row");
+    cut_swatch(&pattern, &model, SwatchSize::Tiles(tiles), GlueSettings::default()).expect("cuts").0
+}
+
+#[test]
+fn stretch_bars_grip_the_yarns_near_their_sides_and_pull_them_apart() {
+    let swatch = stock_swatch([3, 3]);
+    let scene = yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in");
+    let settings = RunSettings::default();
+    let placed = place(&swatch, &scene, &settings).expect("places");
+    assert_eq!(placed.handles.len(), 2);
+    let positions: Vec<[f64; 3]> = placed.yarns.iter().flat_map(|y| y.positions_m.clone()).collect();
+    let [w, h] = swatch.size_m;
+    for (handle, side) in placed.handles.iter().zip([-1.0, 1.0]) {
+        assert!(!handle.vertices.is_empty());
+        for &v in &handle.vertices {
+            let p = positions[v];
+            assert!(side * p[0] >= w / 2.0 - 0.07 * w - 1e-9, "held {p:?} is not within 7% of side {side}");
+            assert!(p[1].abs() <= h / 2.0, "{p:?}");
+        }
+    }
+    // Centred: the rectangle on the origin, the yarns' mean height at 0.
+    let mean = |k: usize| positions.iter().map(|p| p[k]).sum::<f64>() / positions.len() as f64;
+    assert!(mean(2).abs() < 1e-12);
+    assert!(positions.iter().all(|p| p[0].abs() <= w / 2.0 + 1e-12 && p[1].abs() <= h / 2.0 + 1e-12));
+
+    let mut simulation = Simulation::new(&placed).expect("a valid scene");
+    let width_at = |s: &Simulation| {
+        let p = s.positions_m();
+        let xs = placed.handles[1].vertices.iter().map(|&v| p[v][0]);
+        xs.fold(f64::INFINITY, f64::min)
+    };
+    let start = width_at(&simulation);
+    let mut closest = f64::INFINITY;
+    run(&mut simulation, 0, 2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
+        closest = closest.min(report.closest_distance_radii);
+        Ok(())
+    })
+    .expect("runs");
+    let moved = width_at(&simulation) - start;
+    let expected = 0.035 * simulation.time_s() / 0.4;
+    assert!((moved - expected).abs() < 1e-12, "the +x bar moved {moved} m, its motion {expected} m");
+    assert!(closest > 0.5, "closest centrelines {closest} radii");
+}
+
+#[test]
+fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
+    let swatch = stock_swatch([2, 2]);
+    let scene = yarnhom_shell::Scene::builtin("drape").expect("a built-in");
+    // The drape's handle spheres sit 10 cm off the centre: on a 3 cm swatch they grip nothing.
+    let error = place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("no yarn in the spheres");
+    assert!(matches!(error, RunError::NothingHeld { handle: 0, .. }), "{error}");
+
+    let scene = yarnhom_shell::Scene { handles: vec![], ..scene };
+    let placed = place(&swatch, &scene, &RunSettings::default()).expect("places");
+    assert_eq!(placed.obstacles.len(), 1, "the drape's sphere");
+    let mut simulation = Simulation::new(&placed).expect("a valid scene");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join("run.mcap");
+    let path = path.to_str().expect("utf-8");
+    let mut sink = TraceSink::open(path, &TraceMetadata::new("test", "0")).expect("opens");
+    run(&mut simulation, 0, 2, scene.frame_time_s, 2, |report, s| {
+        record_frame(&mut sink, report, s, "stock").map_err(|e| e.to_string())
+    })
+    .expect("runs");
+    sink.finish().expect("finishes");
+
+    let (mut frames, mut metrics, mut steps) = (vec![], 0, 0);
+    for message in TraceReader::new(std::fs::File::open(path).expect("opens")) {
+        match message.expect("reads") {
+            TraceMessage::Yarns(f) => frames.push(f),
+            TraceMessage::Scalars(s) => {
+                metrics += 1;
+                assert!(s.values["closest_distance_radii"] > 0.5);
+                assert!(s.values.values().all(|v| !v.is_nan()));
+            }
+            TraceMessage::Solver(_) => steps += 1,
+            _ => {}
+        }
+    }
+    assert_eq!(frames.iter().map(|f| f.frame).collect::<Vec<_>>(), vec![0, 1, 2]);
+    assert_eq!((metrics, steps), (3, 4), "a scalar record per frame, a solver record per step");
+    let f = &frames[2];
+    assert_eq!(f.positions_m.len(), swatch.positions_m.len());
+    assert_eq!(f.yarn_ranges.len(), swatch.yarns.len());
+    assert!(f.radii_m.iter().all(|&r| r == swatch.yarns[0].radius_m));
+    let dropped = frames[2].positions_m.iter().zip(&frames[0].positions_m).map(|(a, b)| a[2] - b[2]);
+    assert!(dropped.clone().all(|dz| dz < 0.0), "gravity pulls every vertex down");
+}
+
+#[test]
+fn box_obstacles_and_bad_settings_are_refused() {
+    let swatch = stock_swatch([2, 2]);
+    let scene = yarnhom_shell::Scene {
+        obstacles: vec![yarnhom_shell::contact::Obstacle::Box { min: [-1.0, -1.0, -2.0], max: [1.0, 1.0, -1.0] }],
+        ..yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in")
+    };
+    let error = place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("a box");
+    assert!(error.to_string().contains("box obstacles are not modelled"), "{error}");
+    let scene = yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in");
+    for settings in [
+        RunSettings { steps_per_frame: 0, ..RunSettings::default() },
+        RunSettings { damping_rate_per_s: f64::NAN, ..RunSettings::default() },
+        RunSettings { obstacle_stiffness_n_m: -1.0, ..RunSettings::default() },
+    ] {
+        assert!(matches!(place(&swatch, &scene, &settings), Err(RunError::Settings(_))));
+    }
+}
