@@ -24,6 +24,7 @@ mod schema;
 mod shell;
 mod trace;
 mod trace_export;
+mod yls;
 
 use std::process::ExitCode;
 
@@ -63,6 +64,10 @@ enum Command {
     /// materials, recorded as MCAP traces.
     #[command(subcommand)]
     Shell(shell::ShellCommand),
+    /// Yarn-level simulation of whole swatches (thesis Sec. 4.3.1): cut a swatch from a
+    /// pattern, simulate the shell simulator's scenes on it yarn by yarn.
+    #[command(subcommand)]
+    Yls(yls::YlsCommand),
     /// MCAP traces as stream filters: info, select, decimate, merge, export (OBJ, PLY, HDF5).
     /// Each reads a file or stdin (`-`) and writes a file or stdout (`-`).
     #[command(subcommand)]
@@ -105,6 +110,7 @@ fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Grid(cmd) => grid::run(cmd),
         Command::Fit(args) => fit::run(args),
         Command::Shell(cmd) => shell::run(cmd),
+        Command::Yls(cmd) => yls::run(cmd),
         Command::Trace(cmd) => trace::run(cmd),
         #[cfg(feature = "rerun")]
         Command::Rerun(args) => rerun_cmd::run(args),

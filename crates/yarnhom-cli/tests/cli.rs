@@ -244,6 +244,9 @@ fn every_command_explains_itself() {
         &["shell"],
         &["shell", "simulate"],
         &["shell", "scene"],
+        &["yls"],
+        &["yls", "swatch"],
+        &["yls", "simulate"],
     ];
     for cmd in commands {
         let mut args = cmd.to_vec();

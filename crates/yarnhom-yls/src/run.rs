@@ -208,21 +208,17 @@ pub struct FrameReport {
 }
 
 /// Run `simulation` from its current state for `frames` output frames of `frame_time_s`, each
-/// of `steps_per_frame` steps, calling `on_frame` after each (and once at the start, as frame
-/// `first_frame`, unless resuming: `first_frame > 0`). Frames are numbered from `first_frame`.
+/// of `steps_per_frame` steps, calling `on_frame` at the start (frame 0) and after each frame.
 pub fn run(
     simulation: &mut Simulation,
-    first_frame: u64,
     frames: u64,
     frame_time_s: f64,
     steps_per_frame: u32,
     mut on_frame: impl FnMut(&FrameReport, &Simulation) -> Result<(), String>,
 ) -> Result<(), RunError> {
     let time_step_s = frame_time_s / f64::from(steps_per_frame);
-    if first_frame == 0 {
-        on_frame(&frame_report(simulation, 0, vec![]), simulation).map_err(RunError::Output)?;
-    }
-    for frame in first_frame + 1..=first_frame + frames {
+    on_frame(&frame_report(simulation, 0, vec![]), simulation).map_err(RunError::Output)?;
+    for frame in 1..=frames {
         let steps = (0..steps_per_frame)
             .map(|_| simulation.step(time_step_s))
             .collect::<Result<Vec<_>, _>>()

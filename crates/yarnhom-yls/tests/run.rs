@@ -47,7 +47,7 @@ fn stretch_bars_grip_the_yarns_near_their_sides_and_pull_them_apart() {
     };
     let start = width_at(&simulation);
     let mut closest = f64::INFINITY;
-    run(&mut simulation, 0, 2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
+    run(&mut simulation, 2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
         closest = closest.min(report.closest_distance_radii);
         Ok(())
     })
@@ -74,7 +74,7 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     let path = dir.path().join("run.mcap");
     let path = path.to_str().expect("utf-8");
     let mut sink = TraceSink::open(path, &TraceMetadata::new("test", "0")).expect("opens");
-    run(&mut simulation, 0, 2, scene.frame_time_s, 2, |report, s| {
+    run(&mut simulation, 2, scene.frame_time_s, 2, |report, s| {
         record_frame(&mut sink, report, s, "stock").map_err(|e| e.to_string())
     })
     .expect("runs");

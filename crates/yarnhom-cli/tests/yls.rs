@@ -1,0 +1,52 @@
+//! `yarnhom yls`: a swatch cut from the published stockinette, a built-in scene simulated on
+//! it, the trace read back; bad input refused in one line.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use yarnhom_trace::{TraceMessage, TraceReader};
+
+const STOCK: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/hylc-patterns/stock.pyp");
+
+fn yarnhom(args: &[&str], cwd: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_yarnhom")).args(args).current_dir(cwd).output().expect("run yarnhom")
+}
+
+fn ok(args: &[&str], cwd: &Path) -> String {
+    let o = yarnhom(args, cwd);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(o.status.success(), "yarnhom {args:?} failed: {err}");
+    err
+}
+
+fn fails_with(args: &[&str], cwd: &Path, problem: &str) {
+    let o = yarnhom(args, cwd);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "yarnhom {args:?}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.contains(problem), "yarnhom {args:?}: expected '{problem}' in: {err}");
+}
+
+#[test]
+fn a_swatch_is_cut_and_a_stretch_is_simulated_on_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let report = ok(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--tiles", "2x2", "-o", "s.swatch.yh"], d);
+    assert!(report.contains("yarns") && report.contains("glue springs"), "{report}");
+    let inspected = String::from_utf8_lossy(&yarnhom(&["inspect", "s.swatch.yh"], d).stdout).into_owned();
+    assert!(inspected.contains("swatch"), "{inspected}");
+
+    ok(&["yls", "simulate", "stretch-x", "--swatch", "s.swatch.yh", "--frames", "1", "-o", "run.mcap"], d);
+    let mut frames = Vec::new();
+    for message in TraceReader::new(std::fs::File::open(d.join("run.mcap")).expect("the trace")) {
+        if let TraceMessage::Yarns(f) = message.expect("reads") {
+            frames.push(f);
+        }
+    }
+    assert_eq!(frames.iter().map(|f| f.frame).collect::<Vec<_>>(), vec![0, 1]);
+    assert!(frames[1].positions_m.iter().all(|p| p.iter().all(|x| x.is_finite())));
+
+    fails_with(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--size", "0.001x0.3", "-o", "x.yh"], d, "tile");
+    fails_with(&["yls", "simulate", "drape", "--swatch", "s.swatch.yh", "-o", "x.mcap"], d, "holds no yarn vertex");
+    fails_with(&["yls", "simulate", "stretch-x", "--swatch", STOCK, "-o", "x.mcap"], d, "swatch");
+}
