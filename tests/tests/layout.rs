@@ -142,7 +142,7 @@ fn the_cli_is_thin() {
     let lines: usize =
         files.iter().map(|f| std::fs::read_to_string(f).expect("readable").lines().count()).sum();
     // 2500 held twelve stages; the yarn-level stage (`yls`) adds its wiring.
-    assert!(lines < 2650, "crates/yarnhom-cli/src has {lines} lines: the CLI parses, prints and wires");
+    assert!(lines < 2700, "crates/yarnhom-cli/src has {lines} lines: the CLI parses, prints and wires");
     for file in &files {
         let long = long_functions(&std::fs::read_to_string(file).expect("readable"), 60);
         assert!(long.is_empty(), "{}: functions over 60 lines: {long:?}", file.display());

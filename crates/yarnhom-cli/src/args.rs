@@ -38,3 +38,14 @@ pub fn finite(text: &str) -> Result<f64, String> {
 pub fn max_stretch(text: &str) -> Result<f64, String> {
     number(text, |x| x.is_finite() && x > 0.0 && x <= 2.0, "must be in (0, 2]")
 }
+
+/// `K/N`: shard `K` of `N`, `0 <= K < N` (a `value_parser`).
+pub fn parse_shard(text: &str) -> Result<(u32, u32), String> {
+    let (k, n) = text.split_once('/').ok_or("expected K/N, e.g. 0/4")?;
+    let (k, n): (u32, u32) =
+        (k.parse().map_err(|_| "K is not a number")?, n.parse().map_err(|_| "N is not a number")?);
+    if n == 0 || k >= n {
+        return Err(format!("shard {k}/{n}: need 0 <= K < N"));
+    }
+    Ok((k, n))
+}

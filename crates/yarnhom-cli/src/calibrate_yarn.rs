@@ -57,7 +57,7 @@ pub struct YarnArgs {
     pub seed: u64,
     /// Run shard K of N independent sub-swarms (N times fewer particles, seed offset by K) and
     /// skip the local step; finish with `--start-from` on the shards' yarn-fit.json files.
-    #[arg(long, value_parser = parse_shard)]
+    #[arg(long, value_parser = crate::args::parse_shard)]
     pub shard: Option<(u32, u32)>,
     /// Skip the swarm: start the local step from the best point of these yarn-fit.json files
     /// (e.g. the shards').
@@ -70,16 +70,6 @@ pub struct YarnArgs {
     /// Rest-shape resets per evaluation (Sec. 6.5.2).
     #[arg(long, default_value_t = 8)]
     pub max_resets: u32,
-}
-
-fn parse_shard(text: &str) -> Result<(u32, u32), String> {
-    let (k, n) = text.split_once('/').ok_or("expected K/N, e.g. 0/4")?;
-    let (k, n): (u32, u32) =
-        (k.parse().map_err(|_| "K is not a number")?, n.parse().map_err(|_| "N is not a number")?);
-    if n == 0 || k >= n {
-        return Err(format!("shard {k}/{n}: need 0 <= K < N"));
-    }
-    Ok((k, n))
 }
 
 impl YarnArgs {

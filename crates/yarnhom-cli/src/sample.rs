@@ -49,8 +49,8 @@ pub struct SampleArgs {
     pub plane_ranges: Vec<PlaneRange>,
     /// Compute this shard `K/N` of the sweep lines only (0 <= K < N); merge the shards with
     /// `yarnhom grid merge`.
-    #[arg(long, value_name = "K/N")]
-    pub shard: Option<String>,
+    #[arg(long, value_name = "K/N", value_parser = crate::args::parse_shard)]
+    pub shard: Option<(u32, u32)>,
     /// Store every sample's equilibrium geometry (for yarn detail, Ch. 5).
     #[arg(long)]
     pub geometry: bool,
@@ -120,7 +120,7 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
     let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
     let plan = SamplePlan::thesis(&plan_ranges(&args)?, args.n1d, args.n2d)?;
-    let shard = args.shard.as_deref().map(parse_shard).transpose()?;
+    let shard = args.shard.map(|(index, count)| GridShard { index, count });
     let options = SampleOptions {
         max_iterations: args.max_iterations,
         stress: !args.no_stress,
@@ -189,14 +189,4 @@ fn trace_metadata(args: &SampleArgs) -> TraceMetadata {
         .with_entry("model", &args.model)
         .with_entry("n1d", args.n1d.to_string())
         .with_entry("n2d", args.n2d.to_string())
-}
-
-/// `K/N` with `0 <= K < N`.
-fn parse_shard(text: &str) -> anyhow::Result<GridShard> {
-    let parse = || -> Option<GridShard> {
-        let (k, n) = text.split_once('/')?;
-        let (index, count) = (k.trim().parse().ok()?, n.trim().parse().ok()?);
-        (index < count).then_some(GridShard { index, count })
-    };
-    parse().ok_or_else(|| anyhow::anyhow!("--shard {text}: expected K/N with 0 <= K < N, e.g. 3/16"))
 }

@@ -7,13 +7,14 @@ use yarnhom_artifacts::open::{open_artifact, open_pattern_and_model};
 use yarnhom_artifacts::{GlueSettings, Swatch};
 use yarnhom_trace::TraceMetadata;
 use yarnhom_yls::dynamics::Simulation;
-use yarnhom_yls::record::record_frame;
-use yarnhom_yls::run::{RunSettings, place, run as run_frames};
+use yarnhom_yls::record::record_run;
+use yarnhom_yls::run::{RunSettings, place};
 use yarnhom_yls::swatch::{SwatchSize, cut_swatch};
+use yarnhom_yls::variations::{Variation, shard_sequences};
 
 use crate::Outcome;
 use crate::args::{non_negative, positive};
-use crate::output::{finish_trace, open_trace, progress_bar, write_artifact, wrote};
+use crate::output::{create_dir, finish_trace, open_trace, progress_bar, write_artifact, wrote};
 
 #[derive(Debug, Subcommand)]
 pub enum YlsCommand {
@@ -28,6 +29,13 @@ pub enum YlsCommand {
     /// statistics per step (`/solver`). Obstacle friction and the shell's Rayleigh damping are
     /// not used; the yarns get Kaldor's damping of non-rigid motion.
     Simulate(SimulateArgs),
+    /// Record training sequences: `--variations` randomized variants of each scene (handle
+    /// motions scaled by 0.5-1.5, sphere obstacles shifted by up to 10% of the swatch, the
+    /// swatch lifted by up to a tenth of its size; variant 0 as written), one trace per
+    /// sequence, `DIR/seq_NNNNNN.mcap`, with its draws in the trace's metadata. Sequences
+    /// already in DIR are kept (a rerun resumes); `--shard K/N` records every N-th sequence
+    /// from K (a Slurm array or Kubernetes Indexed Job) exactly as the whole recording would.
+    Record(RecordArgs),
 }
 
 #[derive(Debug, Args)]
@@ -58,12 +66,18 @@ pub struct SwatchArgs {
 pub struct SimulateArgs {
     /// The scene: built-in name, yarnhom scene JSON or ARCSim-HYLC scene JSON.
     pub scene: String,
-    /// The swatch (`yls swatch`).
-    #[arg(long)]
-    pub swatch: PathBuf,
+    #[command(flatten)]
+    pub run: RunArgs,
     /// Output trace (`.mcap`); `-` writes to stdout.
     #[arg(short, long, visible_alias = "trace")]
     pub output: String,
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The swatch (`yls swatch`).
+    #[arg(long)]
+    pub swatch: PathBuf,
     /// Stop after this many frames (default: the scene's end time).
     #[arg(long)]
     pub frames: Option<u64>,
@@ -73,6 +87,27 @@ pub struct SimulateArgs {
     /// Rate of Kaldor's damping of non-rigid motion (1/s).
     #[arg(long, default_value_t = RunSettings::default().damping_rate_per_s, value_parser = non_negative)]
     pub damping: f64,
+}
+
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// Scenes (built-in names or scene files).
+    #[arg(required = true)]
+    pub scenes: Vec<String>,
+    #[command(flatten)]
+    pub run: RunArgs,
+    /// Variants per scene.
+    #[arg(long, default_value_t = 1)]
+    pub variations: u64,
+    /// Seed of the variants' draws.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Record only shard K of N (`K/N`).
+    #[arg(long, value_parser = crate::args::parse_shard)]
+    pub shard: Option<(u32, u32)>,
+    /// Output folder.
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 /// `AxB` as two numbers.
@@ -86,6 +121,7 @@ pub fn run(cmd: YlsCommand) -> anyhow::Result<Outcome> {
     match cmd {
         YlsCommand::Swatch(args) => swatch(args),
         YlsCommand::Simulate(args) => simulate(args),
+        YlsCommand::Record(args) => record(args),
     }
 }
 
@@ -106,26 +142,66 @@ fn swatch(args: SwatchArgs) -> anyhow::Result<Outcome> {
 
 fn simulate(args: SimulateArgs) -> anyhow::Result<Outcome> {
     let scene = yarnhom_shell::Scene::load(&args.scene)?;
-    let swatch = open_artifact::<Swatch>(&args.swatch)?.value;
-    let settings =
-        RunSettings { steps_per_frame: args.steps_per_frame, damping_rate_per_s: args.damping, ..RunSettings::default() };
-    let mut simulation = Simulation::new(&place(&swatch, &scene, &settings)?)?;
-    let metadata = TraceMetadata::new("yarnhom yls simulate", env!("CARGO_PKG_VERSION"))
-        .with_entry("scene", &args.scene)
+    let swatch = open_artifact::<Swatch>(&args.run.swatch)?.value;
+    let placed = place(&swatch, &scene, &settings(&args.run))?;
+    let metadata = metadata(&args.run, &args.scene, serde_json::Value::Null);
+    run_to_trace(&args.run, &swatch, &scene, placed, &args.output, &metadata)?;
+    Ok(Outcome::Success)
+}
+
+fn record(args: RecordArgs) -> anyhow::Result<Outcome> {
+    let scenes = args.scenes.iter().map(|s| yarnhom_shell::Scene::load(s)).collect::<Result<Vec<_>, _>>()?;
+    let swatch = open_artifact::<Swatch>(&args.run.swatch)?.value;
+    create_dir(&args.output)?;
+    let (index, count) = args.shard.map_or((0, 1), |(k, n)| (u64::from(k), u64::from(n)));
+    for sequence in shard_sequences(scenes.len() as u64 * args.variations, index, count) {
+        let path = args.output.join(format!("seq_{sequence:06}.mcap"));
+        if path.exists() {
+            eprintln!("{} exists: kept", path.display());
+            continue;
+        }
+        let variation = Variation::draw(sequence, args.variations, args.seed, swatch.size_m);
+        let scene = variation.apply_to_scene(&scenes[variation.scene]);
+        let placed = variation.lift(place(&swatch, &scene, &settings(&args.run))?);
+        let metadata = metadata(&args.run, &args.scenes[variation.scene], serde_json::to_value(variation)?);
+        eprintln!("sequence {sequence}: {} variant {}", scene.name, variation.variation);
+        run_to_trace(&args.run, &swatch, &scene, placed, path.to_str().unwrap_or_default(), &metadata)?;
+    }
+    Ok(Outcome::Success)
+}
+
+fn settings(args: &RunArgs) -> RunSettings {
+    RunSettings { steps_per_frame: args.steps_per_frame, damping_rate_per_s: args.damping, ..RunSettings::default() }
+}
+
+fn metadata(args: &RunArgs, scene: &str, variation: serde_json::Value) -> TraceMetadata {
+    TraceMetadata::new("yarnhom yls", env!("CARGO_PKG_VERSION"))
+        .with_entry("scene", scene)
         .with_entry("swatch", args.swatch.display().to_string())
         .with_entry("steps_per_frame", args.steps_per_frame.to_string())
-        .with_entry("damping_rate_per_s", args.damping.to_string());
-    let mut trace = open_trace(&args.output, &metadata)?;
+        .with_entry("damping_rate_per_s", args.damping.to_string())
+        .with_entry("variation", variation.to_string())
+}
+
+/// Simulates `placed` (the swatch in `scene`) into the trace at `output`, with a progress bar.
+fn run_to_trace(
+    args: &RunArgs,
+    swatch: &Swatch,
+    scene: &yarnhom_shell::Scene,
+    placed: yarnhom_yls::dynamics::Scene,
+    output: &str,
+    metadata: &TraceMetadata,
+) -> anyhow::Result<()> {
+    let mut simulation = Simulation::new(&placed)?;
+    let mut trace = open_trace(output, metadata)?;
     let frames = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
     let bar = progress_bar(frames, "frames");
-    run_frames(&mut simulation, frames, scene.frame_time_s, settings.steps_per_frame, |report, sim| {
-        record_frame(&mut trace, report, sim, &swatch.name).map_err(|e| e.to_string())?;
-        bar.set_position(report.frame);
-        bar.set_message(format!("closest {:.2} r", report.closest_distance_radii));
-        Ok(())
+    record_run(&mut trace, &mut simulation, &swatch.name, frames, scene.frame_time_s, args.steps_per_frame, |r| {
+        bar.set_position(r.frame);
+        bar.set_message(format!("closest {:.2} r", r.closest_distance_radii));
     })?;
     bar.finish_and_clear();
-    finish_trace(Some(trace), Some(&args.output))?;
+    finish_trace(Some(trace), Some(output))?;
     eprintln!("simulated {} s of {} yarns, {} vertices", simulation.time_s(), swatch.yarns.len(), swatch.positions_m.len());
-    Ok(Outcome::Success)
+    Ok(())
 }

@@ -50,3 +50,31 @@ fn a_swatch_is_cut_and_a_stretch_is_simulated_on_it() {
     fails_with(&["yls", "simulate", "drape", "--swatch", "s.swatch.yh", "-o", "x.mcap"], d, "holds no yarn vertex");
     fails_with(&["yls", "simulate", "stretch-x", "--swatch", STOCK, "-o", "x.mcap"], d, "swatch");
 }
+
+#[test]
+fn record_writes_one_trace_per_sequence_shard_by_shard_and_resumes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    ok(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--tiles", "2x2", "-o", "s.swatch.yh"], d);
+    let record = |shard: &str| {
+        let args = ["yls", "record", "stretch-x", "--swatch", "s.swatch.yh", "--variations", "2", "--seed", "5"];
+        let mut args = args.to_vec();
+        args.extend(["--frames", "1", "--shard", shard, "-o", "data"]);
+        ok(&args, d)
+    };
+    record("1/2");
+    assert!(!d.join("data/seq_000000.mcap").exists() && d.join("data/seq_000001.mcap").exists());
+    record("0/2");
+    let again = record("1/2");
+    assert!(again.contains("seq_000001.mcap exists: kept"), "{again}");
+    let metadata = |name: &str| {
+        let bytes = std::fs::read(d.join("data").join(name)).expect("the trace");
+        yarnhom_trace::read_metadata(&bytes).expect("metadata").remove(0)
+    };
+    let first = metadata("seq_000000.mcap");
+    let second = metadata("seq_000001.mcap");
+    let variation = |m: &yarnhom_trace::TraceMetadata| m.entries["variation"].clone();
+    assert!(variation(&first).contains("\"motion_scale\":1.0"), "{}", variation(&first));
+    assert!(variation(&second).contains("\"variation\":1"), "{}", variation(&second));
+    assert_ne!(variation(&first), variation(&second));
+}

@@ -5,3 +5,4 @@ pub mod record;
 pub mod run;
 pub mod scene;
 pub mod swatch;
+pub mod variations;

@@ -85,3 +85,22 @@ pub fn record_frame(
     solver_steps(report).iter().try_for_each(|step| sink.write(step))?;
     sink.end_frame()
 }
+
+/// Run `simulation` for `frames` frames of `frame_time_s` (each of `steps_per_frame` steps),
+/// recording every frame, the initial one included, as yarn set `name` on `sink`; `progress`
+/// sees each frame's report after it is recorded.
+pub fn record_run(
+    sink: &mut TraceSink,
+    simulation: &mut Simulation,
+    name: &str,
+    frames: u64,
+    frame_time_s: f64,
+    steps_per_frame: u32,
+    mut progress: impl FnMut(&FrameReport),
+) -> Result<(), crate::run::RunError> {
+    crate::run::run(simulation, frames, frame_time_s, steps_per_frame, |report, sim| {
+        record_frame(sink, report, sim, name).map_err(|e| e.to_string())?;
+        progress(report);
+        Ok(())
+    })
+}
