@@ -26,7 +26,8 @@ pub enum TraceCommand {
     /// Interleave several traces by time into one.
     Merge(MergeArgs),
     /// Export a trace: per-frame OBJ or PLY files (meshes, tet-mesh boundaries, yarn
-    /// polylines) into a folder, or one HDF5 file of fixed-shape arrays for training.
+    /// polylines) into a folder, one HDF5 file of fixed-shape arrays for training, or yarn-level
+    /// traces as a MeshGraphNets-style training set.
     Export(crate::trace_export::ExportArgs),
 }
 

@@ -59,7 +59,7 @@ fn record_writes_one_trace_per_sequence_shard_by_shard_and_resumes() {
     let record = |shard: &str| {
         let args = ["yls", "record", "stretch-x", "--swatch", "s.swatch.yh", "--variations", "2", "--seed", "5"];
         let mut args = args.to_vec();
-        args.extend(["--frames", "1", "--shard", shard, "-o", "data"]);
+        args.extend(["--frames", "2", "--shard", shard, "-o", "data"]);
         ok(&args, d)
     };
     record("1/2");
@@ -77,4 +77,11 @@ fn record_writes_one_trace_per_sequence_shard_by_shard_and_resumes() {
     assert!(variation(&first).contains("\"motion_scale\":1.0"), "{}", variation(&first));
     assert!(variation(&second).contains("\"variation\":1"), "{}", variation(&second));
     assert_ne!(variation(&first), variation(&second));
+
+    // The sequences as a training set: the bars' vertices are handles.
+    ok(&["trace", "export", "--format", "training", "data/seq_000000.mcap", "data/seq_000001.mcap", "-o", "set"], d);
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.join("set/meta.json")).expect("meta.json")).expect("JSON");
+    assert_eq!(meta["trajectory_length"], 3, "{meta}");
+    assert_eq!(meta["sequences"].as_array().map(Vec::len), Some(2), "{meta}");
 }

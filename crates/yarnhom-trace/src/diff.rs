@@ -806,6 +806,30 @@ mod tests {
     }
 
     #[test]
+    fn yarn_nodes_are_matched_by_their_yarn_set() {
+        let nodes = |handle: u8| {
+            let mut writer = TraceWriter::new(Cursor::new(Vec::new())).expect("writer");
+            for yarns in ["a", "b"] {
+                let message = crate::YarnNodes {
+                    yarns: yarns.into(),
+                    rest_positions_m: vec![[0.0; 3]; 3],
+                    node_type: vec![handle, 0, 0],
+                    edges: vec![[0, 1], [1, 2]],
+                };
+                writer.write(&message).expect("nodes");
+            }
+            writer.finish().expect("finish").into_inner()
+        };
+        let d = diff(&nodes(3), &nodes(0));
+        let topic = d.topic("/yarn/nodes").expect("nodes");
+        assert_eq!(topic.matched, 2);
+        let types = topic.fields.iter().find(|f| f.field == "node_type").expect("node_type");
+        assert_eq!(types.outside, 2, "{}", d.report());
+        assert_eq!(types.worst_at.as_deref(), Some("message 0, yarns a, node_type[0]"), "{}", d.report());
+        assert!(diff(&nodes(3), &nodes(3)).equal());
+    }
+
+    #[test]
     fn a_truncated_trace_is_a_structural_difference() {
         let a = trace(&Changes::default());
         let truncated = &a[..a.len() / 2];

@@ -122,7 +122,7 @@ impl From<mcap::McapError> for TraceError {
 }
 
 /// Where a truncated trace ended; see [`TraceError::Truncated`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct Truncation {
     /// Messages read in full.
     pub messages_recovered: u64,

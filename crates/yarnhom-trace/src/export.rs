@@ -1,13 +1,15 @@
 //! Exporting traces: per-frame OBJ or PLY files for viewers, and (feature `hdf5`) one HDF5 file
-//! of fixed-shape arrays for machine-learning training.
+//! of fixed-shape arrays for machine-learning training, or yarn-level traces as a training set
+//! for learned simulators in the MeshGraphNets layout (module `training`). [`export_paths`] is
+//! `yarnhom trace export`: any of them from traces named by path.
 //!
-//! Both read the trace one record at a time ([`RecordReader`]) and keep one message in memory,
+//! All read the trace one record at a time ([`RecordReader`]) and keep one message in memory,
 //! plus the topologies of the meshes (and, for HDF5, the first frame's yarn ranges of each yarn
 //! set and the names of the metrics and RVE terms). A truncated trace is not an error: whatever
 //! was read before the cut is exported and the [`Truncation`] is returned in [`ExportStats`].
 //! A message that cannot be decoded, or a topic version this crate does not read, is an error.
-//! Messages on topics the format does not hold (unknown topics; for OBJ and PLY every topic but
-//! the geometry) are skipped and counted by topic.
+//! Messages on topics the format does not hold (unknown topics; `/yarn/nodes` but for the
+//! training set; for OBJ and PLY every topic but the geometry) are skipped and counted by topic.
 //!
 //! # OBJ and PLY ([`export_frames`])
 //!
@@ -96,6 +98,14 @@
 //! second, different topology of the same mesh are errors. The file is written to a temporary
 //! file next to the destination and renamed into place when complete: a failed export leaves
 //! nothing behind.
+//!
+//! # Training sets (module `training`, feature `hdf5`)
+//!
+//! Yarn-level traces (`/yarn/frame`, and `/yarn/nodes` where the producer writes it) as a data
+//! set for learned simulators in the layout of the h5py-based MeshGraphNets loaders: `meta.json`
+//! and one HDF5 file per split, a group per sequence with `world_pos [T, N, 3]`, `mesh_pos`,
+//! `node_type`, `edges`, `radius` and `dt`. The module's docs give the layout, why it was chosen
+//! and what is refused.
 
 use std::collections::BTreeMap;
 use std::io::{self, Read};
@@ -105,7 +115,7 @@ use serde::Serialize;
 
 use crate::error::Truncation;
 use crate::records::{RecordReader, TraceRecord};
-use crate::{METADATA_NAME, TraceError, TraceMessage, decode, topics};
+use crate::{METADATA_NAME, TraceError, TraceMessage, decode, open_records, topics};
 
 mod frames;
 mod geometry;
@@ -115,10 +125,41 @@ mod obj;
 mod ply;
 #[cfg(test)]
 mod tests;
+#[cfg(feature = "hdf5")]
+pub mod training;
 
 pub use geometry::{boundary_triangles, check_tet_topology};
 pub use obj::{write_obj, write_obj_polylines};
 pub use ply::{write_ply, write_ply_polylines};
+
+/// What [`export_paths`] writes (`yarnhom trace export --format`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum ExportFormat {
+    /// Wavefront OBJ, one file per frame (`<mesh>_<frame>.obj`) in the folder `-o`.
+    Obj,
+    /// Binary PLY, one file per frame (`<mesh>_<frame>.ply`) in the folder `-o`.
+    Ply,
+    /// One HDF5 file `-o` with a dataset per stream and field, stacked by frame, and a JSON
+    /// manifest of every dataset.
+    Hdf5,
+    /// A MeshGraphNets-style training set of yarn-level sequences, one per yarn set of each
+    /// input: `meta.json` and `train.h5` in the folder `-o` (`-o DIR/SPLIT.h5` for another
+    /// split, e.g. `valid`).
+    Training,
+}
+
+impl ExportFormat {
+    /// The format's name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Obj => "obj",
+            Self::Ply => "ply",
+            Self::Hdf5 => "hdf5",
+            Self::Training => "training",
+        }
+    }
+}
 
 /// The file format of [`export_frames`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -252,6 +293,35 @@ pub enum ExportError {
         problem: String,
     },
 
+    /// An input, or a training set's output folder, that the export cannot use (for the
+    /// training set: a trace without yarn frames, a sequence too short or with another time
+    /// step than the others, a misplaced `/yarn/nodes`, a `meta.json` of something else).
+    #[error("{input}: {problem}")]
+    InvalidInput {
+        /// The input (a trace, a yarn set as `a.mcap, yarns "name"`, or a file of the output).
+        input: String,
+        /// What is wrong.
+        problem: String,
+    },
+
+    /// A format that exports one trace was given several.
+    #[error("--format {format} exports one trace, {count} were given (only `training` takes several)")]
+    InputCount {
+        /// The format's name.
+        format: &'static str,
+        /// The traces given.
+        count: usize,
+    },
+
+    /// A format that needs the `hdf5` feature, in a build without it.
+    #[error(
+        "--format {format} needs the `hdf5` feature: rebuild yarnhom with `--features hdf5` (needs libhdf5)"
+    )]
+    NeedsHdf5 {
+        /// The format's name.
+        format: &'static str,
+    },
+
     /// Writing an HDF5 dataset, group or attribute failed (the shared HDF5 layer of
     /// `yarnhom-artifacts`).
     #[cfg(feature = "hdf5")]
@@ -276,6 +346,31 @@ impl ExportError {
 
     fn frame(stream: &str, frame: u64, problem: String) -> Self {
         Self::InvalidFrame { stream: stream.to_owned(), frame, problem }
+    }
+}
+
+/// Exports the traces at `inputs` (paths; `-` is standard input) in `format` to `output` (a
+/// folder for OBJ, PLY and the training set, a file for HDF5): what `yarnhom trace export`
+/// does. Only [`ExportFormat::Training`] takes several traces; HDF5 and the training set need
+/// the `hdf5` feature.
+pub fn export_paths(
+    format: ExportFormat,
+    inputs: &[String],
+    output: &Path,
+) -> Result<ExportStats, ExportError> {
+    let single = || match inputs {
+        [input] => Ok(input.as_str()),
+        _ => Err(ExportError::InputCount { format: format.name(), count: inputs.len() }),
+    };
+    match format {
+        ExportFormat::Obj => export_frames(open_records(single()?)?, output, FrameFormat::Obj),
+        ExportFormat::Ply => export_frames(open_records(single()?)?, output, FrameFormat::Ply),
+        #[cfg(feature = "hdf5")]
+        ExportFormat::Hdf5 => export_hdf5(open_records(single()?)?, output, single()?),
+        #[cfg(feature = "hdf5")]
+        ExportFormat::Training => training::export_training_paths(inputs, output),
+        #[cfg(not(feature = "hdf5"))]
+        ExportFormat::Hdf5 | ExportFormat::Training => Err(ExportError::NeedsHdf5 { format: format.name() }),
     }
 }
 
@@ -337,6 +432,7 @@ fn topic_of(message: &TraceMessage) -> &str {
         TraceMessage::Topology(_) => topics::MESH_TOPOLOGY,
         TraceMessage::Frame(_) => topics::MESH_FRAME,
         TraceMessage::Yarns(_) => topics::YARN_FRAME,
+        TraceMessage::YarnNodes(_) => topics::YARN_NODES,
         TraceMessage::TetTopology(_) => topics::TET_TOPOLOGY,
         TraceMessage::TetFrame(_) => topics::TET_FRAME,
         TraceMessage::Scalars(_) => topics::METRICS,

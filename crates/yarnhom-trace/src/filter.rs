@@ -312,6 +312,7 @@ mod tests {
     }
     use crate::{
         MeshFrame, MeshTopology, Scalars, TraceMessage, TraceMetadata, TraceReader, TraceWriterOptions,
+        YarnFrame, YarnNodes,
     };
 
     /// A trace of one mesh `name` with `frames` frames at `dt` seconds, plus metrics.
@@ -408,6 +409,45 @@ mod tests {
         assert_eq!(stats.truncated_inputs[0].1.messages_recovered, stats.messages_read);
         assert_eq!(messages.len() as u64, stats.messages_written);
         assert!(stats.messages_written > 0 && stats.messages_written < 401);
+    }
+
+    #[test]
+    fn yarn_nodes_are_kept_like_topologies_and_counted_by_info() {
+        let mut writer = TraceWriter::new(Cursor::new(Vec::new())).expect("writer");
+        let nodes = YarnNodes {
+            yarns: "swatch".into(),
+            rest_positions_m: vec![[0.0; 3], [1e-3, 0.0, 0.0]],
+            node_type: vec![YarnNodes::HANDLE, YarnNodes::NORMAL],
+            edges: vec![[0, 1]],
+        };
+        writer.write(&nodes).expect("nodes");
+        for frame in 0..6 {
+            let positions_m = vec![[0.0, 0.0, frame as f64 * 1e-3], [1e-3, 0.0, 0.0]];
+            let time_s = 0.1 * frame as f64;
+            let yarns = YarnFrame {
+                yarns: "swatch".into(),
+                frame,
+                time_s,
+                positions_m,
+                radii_m: vec![1e-4; 2],
+                yarn_ranges: vec![[0, 2]],
+                ..Default::default()
+            };
+            writer.write(&yarns).expect("frame");
+        }
+        let input = writer.finish().expect("finish").into_inner();
+        for selection in [
+            Selection { every: Some(4), ..Default::default() },
+            Selection { frames: Some(3..5), ..Default::default() },
+            Selection { time_s: Some(0.25..1.0), ..Default::default() },
+            Selection { topics: vec!["/yarn/*".into()], ..Default::default() },
+        ] {
+            let (messages, _) = run_filter(&input, &selection);
+            assert_eq!(messages[0], TraceMessage::YarnNodes(nodes.clone()), "{selection:?}");
+        }
+        let info = info(RecordReader::new(input.as_slice())).expect("info");
+        let topic = &info.topics["/yarn/nodes"];
+        assert_eq!((topic.messages, topic.frames, topic.schema.as_str()), (1, None, "yarnhom.YarnNodes.v1"));
     }
 
     #[test]

@@ -15,7 +15,7 @@ pub use diff::{TopicDiff, TraceDiff, diff_traces};
 pub use error::{TraceError, Truncation};
 pub use messages::{
     MESSAGE_ENCODING, MeshFrame, MeshTopology, RveSample, SCHEMA_ENCODING, Scalars, SolverIteration,
-    SolverStep, TOPIC_VERSION_KEY, TetFrame, TetTopology, Topic, YarnFrame, topic_schemas, topics,
+    SolverStep, TOPIC_VERSION_KEY, TetFrame, TetTopology, Topic, YarnFrame, YarnNodes, topic_schemas, topics,
 };
 pub use metadata::{METADATA_NAME, TraceMetadata, read_metadata};
 pub use reader::{TraceMessage, TraceReader, decode};

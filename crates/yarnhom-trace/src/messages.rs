@@ -13,6 +13,8 @@ pub mod topics {
     pub const MESH_FRAME: &str = "/mesh/frame";
     /// Topic of [`YarnFrame`](crate::YarnFrame) messages.
     pub const YARN_FRAME: &str = "/yarn/frame";
+    /// Topic of [`YarnNodes`](crate::YarnNodes) messages.
+    pub const YARN_NODES: &str = "/yarn/nodes";
     /// Topic of [`TetTopology`](crate::TetTopology) messages.
     pub const TET_TOPOLOGY: &str = "/tet/topology";
     /// Topic of [`TetFrame`](crate::TetFrame) messages.
@@ -84,6 +86,54 @@ pub struct YarnFrame {
     pub radii_m: Vec<f64>,
     /// The yarns as `[first vertex, vertex count]` ranges of `positions_m`, in order.
     pub yarn_ranges: Vec<[u32; 2]>,
+}
+
+/// The nodes of a yarn set as a learned simulator sees them (MeshGraphNets' `mesh_pos`,
+/// `node_type` and graph edges): its rest positions, which vertices are driven, and its
+/// segments. Written on `/yarn/nodes` once per yarn set, before the set's first
+/// [`YarnFrame`]; its vertices are those of the frames, in the same order.
+///
+/// Node types are MeshGraphNets' `NodeType` codes ([`YarnNodes::NORMAL`],
+/// [`YarnNodes::HANDLE`]), so that a training set exported from a trace
+/// (`yarnhom trace export --format training`) means what MeshGraphNets loaders expect. Obstacle
+/// geometry is not a yarn node: it has no vertex in the frames, and the code `OBSTACLE` (1) is
+/// not used.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize, JsonSchema)]
+pub struct YarnNodes {
+    /// Name of the yarn set, as in its [`YarnFrame`]s.
+    pub yarns: String,
+    /// Rest position of each vertex, in metres, in the vertex order of the frames (yarn after
+    /// yarn).
+    pub rest_positions_m: Vec<[f64; 3]>,
+    /// Node type of each vertex, a MeshGraphNets `NodeType` code: 0 (`NORMAL`) for a free
+    /// vertex, 3 (`HANDLE`) for a vertex whose motion is prescribed (pinned, clamped or moved by
+    /// a handle). Other codes are not written by yarnhom (obstacles are not yarn nodes).
+    pub node_type: Vec<u8>,
+    /// The yarn segments, as pairs of 0-based vertex indices (for open yarns the consecutive
+    /// vertices of each yarn range, see [`YarnNodes::chain_edges`]; a closed yarn adds the
+    /// segment from its last vertex back to its first).
+    pub edges: Vec<[u32; 2]>,
+}
+
+impl YarnNodes {
+    /// MeshGraphNets' `NodeType.NORMAL`: a free vertex, moved by the simulation.
+    pub const NORMAL: u8 = 0;
+    /// MeshGraphNets' `NodeType.HANDLE`: a vertex whose motion is prescribed.
+    pub const HANDLE: u8 = 3;
+    /// MeshGraphNets' `NodeType.SIZE`: every code is below it (the width of a one-hot node
+    /// type).
+    pub const CODES: u8 = 9;
+
+    /// The segments of open yarns given as `[first vertex, vertex count]` ranges (as in
+    /// [`YarnFrame::yarn_ranges`]): each vertex with the next one of its yarn, yarn after yarn.
+    pub fn chain_edges(yarn_ranges: &[[u32; 2]]) -> Vec<[u32; 2]> {
+        yarn_ranges
+            .iter()
+            .flat_map(|&[first, count]| {
+                (1..count).map(move |k| [first.saturating_add(k - 1), first.saturating_add(k)])
+            })
+            .collect()
+    }
 }
 
 /// The rest state of a tetrahedral mesh with per-element values (e.g. the fitted `gamma` of
@@ -200,6 +250,7 @@ pub fn topic_schemas() -> Vec<(&'static str, &'static str, schemars::Schema)> {
     vec![
         entry::<MeshTopology>(),
         entry::<MeshFrame>(),
+        entry::<YarnNodes>(),
         entry::<YarnFrame>(),
         entry::<TetTopology>(),
         entry::<TetFrame>(),
@@ -250,6 +301,7 @@ macro_rules! topic {
 
 topic!(MeshTopology, topics::MESH_TOPOLOGY, "yarnhom.MeshTopology.v1", 1);
 topic!(MeshFrame, topics::MESH_FRAME, "yarnhom.MeshFrame.v1", 1);
+topic!(YarnNodes, topics::YARN_NODES, "yarnhom.YarnNodes.v1", 1);
 topic!(YarnFrame, topics::YARN_FRAME, "yarnhom.YarnFrame.v1", 1);
 topic!(TetTopology, topics::TET_TOPOLOGY, "yarnhom.TetTopology.v1", 1);
 topic!(TetFrame, topics::TET_FRAME, "yarnhom.TetFrame.v1", 1);
@@ -271,7 +323,7 @@ macro_rules! untimed {
     )*};
 }
 
-untimed!(MeshTopology, TetTopology);
+untimed!(MeshTopology, YarnNodes, TetTopology);
 
 macro_rules! timed {
     ($($ty:ty),*) => {$(
@@ -299,7 +351,7 @@ mod tests {
         topics.sort_unstable();
         topics.dedup();
         assert_eq!(topics.len(), listed.len());
-        assert_eq!(listed.len(), 9);
+        assert_eq!(listed.len(), 10);
     }
 
     fn check<T: Topic>() {
@@ -314,6 +366,7 @@ mod tests {
     fn topic_constants_are_consistent() {
         check::<MeshTopology>();
         check::<MeshFrame>();
+        check::<YarnNodes>();
         check::<YarnFrame>();
         check::<TetTopology>();
         check::<TetFrame>();
@@ -321,6 +374,12 @@ mod tests {
         check::<SolverStep>();
         check::<SolverIteration>();
         check::<RveSample>();
+    }
+
+    #[test]
+    fn chain_edges_join_consecutive_vertices_of_each_yarn() {
+        assert_eq!(YarnNodes::chain_edges(&[[0, 3], [3, 1], [4, 2]]), [[0, 1], [1, 2], [4, 5]]);
+        assert!(YarnNodes::chain_edges(&[[0, 0]]).is_empty());
     }
 
     #[test]

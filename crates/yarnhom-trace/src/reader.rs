@@ -5,7 +5,7 @@ use std::io::Read;
 use crate::TraceError;
 use crate::messages::{
     MESSAGE_ENCODING, MeshFrame, MeshTopology, RveSample, Scalars, SolverIteration, SolverStep,
-    TOPIC_VERSION_KEY, TetFrame, TetTopology, Topic, YarnFrame, topics,
+    TOPIC_VERSION_KEY, TetFrame, TetTopology, Topic, YarnFrame, YarnNodes, topics,
 };
 use crate::records::{ReadProgress, RecordReader, TraceRecord};
 
@@ -19,6 +19,8 @@ pub enum TraceMessage {
     Frame(MeshFrame),
     /// A `/yarn/frame` message.
     Yarns(YarnFrame),
+    /// A `/yarn/nodes` message.
+    YarnNodes(YarnNodes),
     /// A `/tet/topology` message.
     TetTopology(TetTopology),
     /// A `/tet/frame` message.
@@ -88,6 +90,7 @@ pub fn decode(message: &mcap::Message<'_>) -> Result<TraceMessage, TraceError> {
         topics::MESH_TOPOLOGY => TraceMessage::Topology(decode_as(message)?),
         topics::MESH_FRAME => TraceMessage::Frame(decode_as(message)?),
         topics::YARN_FRAME => TraceMessage::Yarns(decode_as(message)?),
+        topics::YARN_NODES => TraceMessage::YarnNodes(decode_as(message)?),
         topics::TET_TOPOLOGY => TraceMessage::TetTopology(decode_as(message)?),
         topics::TET_FRAME => TraceMessage::TetFrame(decode_as(message)?),
         topics::METRICS => TraceMessage::Scalars(decode_as(message)?),

@@ -1,13 +1,33 @@
-//! A yarn-level run's frames as trace messages (`yarnhom-trace` topics): the yarn centrelines
-//! per frame on `/yarn/frame`, the frame's energies and contact measures on `/metrics`, and each
+//! A yarn-level run's frames as trace messages (`yarnhom-trace` topics): the yarns' rest
+//! positions, node types (free or held by a handle) and segments once on `/yarn/nodes`, the
+//! yarn centrelines per frame on `/yarn/frame`, the frame's energies and contact measures on `/metrics`, and each
 //! time step's Newton statistics on `/solver`.
 
 use std::collections::BTreeMap;
 
-use yarnhom_trace::{Scalars, SolverStep, TraceError, TraceSink, YarnFrame};
+use yarnhom_trace::{Scalars, SolverStep, TraceError, TraceSink, YarnFrame, YarnNodes};
 
 use crate::dynamics::Simulation;
 use crate::run::FrameReport;
+
+/// The yarns of `simulation` as graph nodes of yarn set `name`: its current positions as rest
+/// positions, `HANDLE` for the vertices handles hold and `NORMAL` for the others, and every
+/// segment (a closed yarn's last one back to its first).
+pub fn yarn_nodes(simulation: &Simulation, name: &str) -> YarnNodes {
+    let mut node_type = vec![YarnNodes::NORMAL; simulation.vertex_count()];
+    for v in simulation.held_vertices() {
+        node_type[v] = YarnNodes::HANDLE;
+    }
+    let edges = (0..simulation.yarn_count())
+        .flat_map(|yarn| {
+            let vertices = simulation.yarn_vertices(yarn);
+            let n = vertices.len();
+            let first = vertices.start;
+            (0..simulation.yarn_edge_count(yarn)).map(move |e| [(first + e) as u32, (first + (e + 1) % n) as u32])
+        })
+        .collect();
+    YarnNodes { yarns: name.into(), rest_positions_m: simulation.positions_m(), node_type, edges }
+}
 
 /// The yarn centrelines of `simulation` at `report`'s frame, as yarn set `name`: positions,
 /// the twist of the edge leaving each vertex (0 at an open yarn's last vertex), radii and yarn
@@ -73,13 +93,17 @@ pub fn solver_steps(report: &FrameReport) -> Vec<SolverStep> {
         .collect()
 }
 
-/// Records output frame `report` of yarn set `name` on `sink` and closes the frame.
+/// Records output frame `report` of yarn set `name` on `sink` (its [`yarn_nodes`] first, at
+/// frame 0) and closes the frame.
 pub fn record_frame(
     sink: &mut TraceSink,
     report: &FrameReport,
     simulation: &Simulation,
     name: &str,
 ) -> Result<(), TraceError> {
+    if report.frame == 0 {
+        sink.write(&yarn_nodes(simulation, name))?;
+    }
     sink.write(&yarn_frame(report, simulation, name))?;
     sink.write(&frame_metrics(report))?;
     solver_steps(report).iter().try_for_each(|step| sink.write(step))?;

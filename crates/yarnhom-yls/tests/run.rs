@@ -80,7 +80,7 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     .expect("runs");
     sink.finish().expect("finishes");
 
-    let (mut frames, mut metrics, mut steps) = (vec![], 0, 0);
+    let (mut frames, mut metrics, mut steps, mut nodes) = (vec![], 0, 0, vec![]);
     for message in TraceReader::new(std::fs::File::open(path).expect("opens")) {
         match message.expect("reads") {
             TraceMessage::Yarns(f) => frames.push(f),
@@ -90,10 +90,15 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
                 assert!(s.values.values().all(|v| !v.is_nan()));
             }
             TraceMessage::Solver(_) => steps += 1,
+            TraceMessage::YarnNodes(n) => nodes.push(n),
             _ => {}
         }
     }
     assert_eq!(frames.iter().map(|f| f.frame).collect::<Vec<_>>(), vec![0, 1, 2]);
+    assert_eq!(nodes.len(), 1, "the yarn nodes once");
+    assert_eq!(nodes[0].rest_positions_m, frames[0].positions_m);
+    assert!(nodes[0].node_type.iter().all(|&t| t == yarnhom_trace::YarnNodes::NORMAL), "no handles");
+    assert_eq!(nodes[0].edges, yarnhom_trace::YarnNodes::chain_edges(&frames[0].yarn_ranges));
     assert_eq!((metrics, steps), (3, 4), "a scalar record per frame, a solver record per step");
     let f = &frames[2];
     assert_eq!(f.positions_m.len(), swatch.positions_m.len());

@@ -31,7 +31,7 @@ const CHUNK_BYTES: usize = 64 * 1024;
 const MAX_CHUNK_ROWS: usize = 1024;
 
 /// An HDF5 library error while doing `context`.
-fn h5_error(context: String, error: ::hdf5::Error) -> ExportError {
+pub(super) fn h5_error(context: String, error: ::hdf5::Error) -> ExportError {
     ExportError::Hdf5 { context, error }
 }
 
@@ -693,7 +693,7 @@ fn units_of(name: &str) -> &'static str {
 
 /// The datasets written so far, for the manifest.
 #[derive(Default)]
-struct Catalog {
+pub(super) struct Catalog {
     entries: Vec<DatasetEntry>,
 }
 
@@ -709,7 +709,7 @@ struct DatasetEntry {
 
 impl Catalog {
     /// Writes a dataset of fixed shape in one go.
-    fn fixed<T: H5Type>(
+    pub(super) fn fixed<T: H5Type>(
         &mut self,
         group: &Group,
         name: &str,
@@ -731,7 +731,7 @@ impl Catalog {
 
     /// Creates an empty dataset of rows of shape `row_shape`, chunked and unlimited along its
     /// first dimension.
-    fn growing<T: H5Type>(
+    pub(super) fn growing<T: H5Type>(
         &mut self,
         group: &Group,
         name: &str,
@@ -790,7 +790,7 @@ impl Catalog {
 }
 
 /// A dataset growing by one row per message along its first dimension.
-struct Column {
+pub(super) struct Column {
     dataset: Dataset,
     path: String,
     /// The current shape: rows, then the row shape.
@@ -835,7 +835,10 @@ impl Column {
     }
 
     /// Appends rows of `N` values as one row of a dataset of shape `[F, n, N]`.
-    fn push_rows<T: H5Type, const N: usize>(&mut self, rows: &[[T; N]]) -> Result<(), ExportError> {
+    pub(super) fn push_rows<T: H5Type, const N: usize>(
+        &mut self,
+        rows: &[[T; N]],
+    ) -> Result<(), ExportError> {
         let index = self.grow(1)?;
         let written = self.dataset.write_slice::<&[[T; N]], T, _, _>(rows, (index, .., ..));
         written.map_err(|e| h5_error(format!("cannot write row {index} of {}", self.path), e))

@@ -46,6 +46,13 @@ impl Simulation {
         self.system.vertex_count()
     }
 
+    /// The vertices whose motion handles prescribe, ascending.
+    pub fn held_vertices(&self) -> Vec<usize> {
+        let mut held: Vec<usize> = self.system.held.iter().map(|&(v, _, _)| v).collect();
+        held.sort_unstable();
+        held
+    }
+
     /// Number of yarns.
     pub fn yarn_count(&self) -> usize {
         self.system.vertex_offsets.len() - 1
