@@ -1,16 +1,24 @@
 //! ARCSim-HYLC scene files (`../shared/data/hylc-scenes/*.json`) read into a [`Scene`]: the
 //! cloth square (`hylc_square.obj`, a unit square, scaled), handlebars, handlespheres, their
 //! keyframed translations, sphere obstacles (`sphere.obj`, a unit sphere, scaled), gravity,
-//! obstacle friction, the repulsion thickness and the material's stiffness damping.
+//! obstacle friction, the repulsion thickness, the material's stiffness damping and the air
+//! drag (`wind`, [`crate::wind`], with ARCSim's defaults: density 1 kg/m³ when a scene sets
+//! none).
+//!
+//! Damping as in ARCSim: its implicit integrator damps by the material's `damping` (our
+//! Rayleigh stiffness damping `β`) and the wind only, so imported scenes have no Rayleigh mass
+//! damping (`α = 0`; the published scenes leave `explicit_massdamping`, used only by ARCSim's
+//! explicit integrator, commented out).
 //!
 //! Not carried over: ARCSim's adaptive remeshing (we use a fixed mesh of the built-in
-//! resolution), its 80 substeps per frame (we take [`Scene::steps_per_frame`] implicit steps)
-//! and its wind drag (we use Rayleigh mass damping).
+//! resolution) and its 80 substeps per frame (we take [`Scene::steps_per_frame`] implicit
+//! steps).
 
 use serde_json::Value;
 
 use crate::contact::Obstacle;
 use crate::scene::{HandleSpec, Scene, SceneError};
+use crate::wind::Wind;
 
 fn number(v: &Value, key: &str) -> Option<f64> {
     v.get(key).and_then(Value::as_f64)
@@ -40,6 +48,8 @@ pub fn import(doc: &Value, name: &str) -> Result<Scene, SceneError> {
     scene.end_time_s = number(doc, "end_time").unwrap_or(scene.end_time_s);
     scene.frame_time_s = number(doc, "frame_time").unwrap_or(scene.frame_time_s);
     scene.gravity = triple(doc.get("gravity")).unwrap_or(scene.gravity);
+    scene.wind = wind(doc.get("wind"));
+    scene.mass_damping = 0.0;
     scene.contact.friction = number(doc, "obs_friction").unwrap_or(0.0);
     if let Some(t) = doc.pointer("/magic/repulsion_thickness").and_then(Value::as_f64) {
         scene.contact.thickness_m = t;
@@ -53,6 +63,17 @@ pub fn import(doc: &Value, name: &str) -> Result<Scene, SceneError> {
     }
     scene.validate()?;
     Ok(scene)
+}
+
+/// ARCSim's `wind` with its parser's defaults (`conf.cpp`, `parse(Wind&, ...)`): density 1,
+/// velocity 0, drag 0, also when the scene has no `wind`.
+fn wind(w: Option<&Value>) -> Wind {
+    let get = |key: &str| w.and_then(|w| number(w, key));
+    Wind {
+        density_kg_m3: get("density").unwrap_or(1.0),
+        velocity_m_s: triple(w.and_then(|w| w.get("velocity"))).unwrap_or([0.0; 3]),
+        drag_kg_m2_s: get("drag").unwrap_or(0.0),
+    }
 }
 
 /// Keyframes `(time_s, translation_m)` of one motion.
@@ -143,7 +164,30 @@ mod tests {
                 "{file}"
             );
             assert_eq!(a.contact.thickness_m, b.contact.thickness_m, "{file}");
+            assert_eq!(
+                (a.wind, a.mass_damping, a.stiffness_damping),
+                (b.wind, b.mass_damping, b.stiffness_damping),
+                "{file}"
+            );
         }
+    }
+
+    #[test]
+    fn the_air_drag_is_read_with_arcsims_defaults() {
+        let drape = published("stock_drapeX.json");
+        assert_eq!(drape.wind, Wind { density_kg_m3: 7.5, velocity_m_s: [0.0; 3], drag_kg_m2_s: 0.0 });
+        assert_eq!(drape.mass_damping, 0.0);
+        let doc = |wind: &str| -> Value {
+            serde_json::from_str(&format!(
+                r#"{{"cloths": [{{}}], "handlespheres": [{{"center": [0, 0, 0], "radius": 0.01}}]{wind}}}"#
+            ))
+            .expect("json")
+        };
+        let full = import(&doc(r#", "wind": {"density": 2, "velocity": [1, 0, 0.5], "drag": 0.3}"#), "t")
+            .expect("scene");
+        assert_eq!(full.wind, Wind { density_kg_m3: 2.0, velocity_m_s: [1.0, 0.0, 0.5], drag_kg_m2_s: 0.3 });
+        let none = import(&doc(""), "t").expect("scene");
+        assert_eq!(none.wind, Wind { density_kg_m3: 1.0, ..Wind::default() });
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Implicit Euler time stepping as minimization of the incremental potential (Sec. 4.2): each
 //! step minimizes
 //!
-//! `Φ(x) = Σ m_i |x_i - x̂_i|² / (2h²) + E(x) + E_contact(x) - Σ m_i g·x_i + Φ_damp(x)`,
+//! `Φ(x) = Σ m_i |x_i - x̂_i|² / (2h²) + E(x) + E_contact(x) - Σ (m_i g + f_i)·x_i + Φ_damp(x)`,
 //! `x̂ = x_n + h v_n`,
 //!
 //! by Newton's method with a backtracking line search, from `x̂` or `x_n`
@@ -18,7 +18,9 @@
 //! couplings and vertex blocks) and solved by faer's sparse Cholesky on its symbolic analysis,
 //! both computed once, in memory kept from step to step (module `newton_matrix`), or by
 //! conjugate gradients where the inertia term makes them cheaper ([`crate::linear_solver`]). Friction
-//! against obstacles is applied to the new velocities ([`crate::contact`]).
+//! against obstacles is applied to the new velocities ([`crate::contact`]). The air drag `f`
+//! ([`crate::wind`]) is explicit, as in ARCSim: evaluated once per step at `x_n`, `v_n` and held
+//! constant over it, so it adds to the gradient and nothing to the Newton matrix.
 
 use std::time::Instant;
 
@@ -32,6 +34,7 @@ use crate::linear_solver::{
     jacobi_condition_bound, predicted_iterations,
 };
 use crate::newton_matrix::{CholeskyWorkspace, HessianPattern, NewtonAssembly};
+use crate::wind::Wind;
 
 /// Newton starts at the inertial prediction when it moves no vertex by more than this many
 /// Newton tolerances ([`Simulation::step`]).
@@ -83,6 +86,8 @@ pub struct Dynamics {
     pub mass_damping: f64,
     /// Rayleigh stiffness damping `β` (s).
     pub stiffness_damping: f64,
+    /// Air drag, explicit ([`crate::wind`]).
+    pub wind: Wind,
     /// Most Newton iterations per step.
     pub max_newton_iterations: u32,
     /// Newton stops when the largest position update is below this (m).
@@ -139,6 +144,8 @@ pub struct Simulation {
     /// Simulated time (s).
     pub time_s: f64,
     masses: Vec<f64>,
+    /// Material area of each triangle (m²), for the air drag.
+    rest_areas: Vec<f64>,
     handles: Vec<Handle>,
     handle_origins: Vec<Vec<Vector3<f64>>>,
     fixed: Vec<bool>,
@@ -164,6 +171,8 @@ struct StepTerms {
     start: Vec<Vector3<f64>>,
     /// `β K_n` on the pattern (empty without stiffness damping).
     stiffness_damping: Vec<f64>,
+    /// The air drag on each vertex at `x_n`, `v_n` (N; empty without wind).
+    wind: Vec<Vector3<f64>>,
 }
 
 impl Simulation {
@@ -198,6 +207,7 @@ impl Simulation {
             positions,
             time_s: 0.0,
             masses,
+            rest_areas: model.mesh.rest_areas(),
             handles,
             handle_origins,
             fixed,
@@ -254,7 +264,8 @@ impl Simulation {
         let next_time = self.time_s + h;
         let start = self.positions.clone();
         let predicted: Vec<_> = start.iter().zip(&self.velocities).map(|(x, v)| x + h * v).collect();
-        let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new() };
+        let wind = self.wind_forces();
+        let mut terms = StepTerms { predicted, start, stiffness_damping: Vec::new(), wind };
         let mut x = self.newton_start(&terms, next_time);
         let mut stats = StepStats {
             newton_iterations: 0,
@@ -363,6 +374,15 @@ impl Simulation {
         run.converged.then_some(x)
     }
 
+    /// The air drag on each vertex in the current state (N; empty without wind).
+    pub fn wind_forces(&self) -> Vec<Vector3<f64>> {
+        let wind = self.dynamics.wind;
+        if wind.is_none() {
+            return Vec::new();
+        }
+        wind.vertex_forces_n(&self.model.mesh, &self.rest_areas, &self.positions, &self.velocities)
+    }
+
     /// Where Newton starts, handles at their positions at `time_s`: at the inertial prediction
     /// `x̂ = x_n + h v_n` when no vertex's `h |v_i|` exceeds [`INERTIAL_START_TOLERANCES`]
     /// Newton tolerances, else at `x_n`. From `x̂` the first update is of the order of `h² a`,
@@ -428,6 +448,7 @@ impl Simulation {
             phi += m * (p - terms.predicted[i]).norm_squared() / (2.0 * h * h) - m * g.dot(p);
             phi += alpha * m * (p - terms.start[i]).norm_squared() / (2.0 * h);
         }
+        phi -= terms.wind.iter().zip(x).map(|(f, p)| f.dot(p)).sum::<f64>();
         phi += crate::contact::obstacle_energy(&self.obstacles, &self.contact, x);
         if let Some(s) = &self.self_collision {
             phi += s.energy(&s.pairs(x));
@@ -474,7 +495,11 @@ impl Simulation {
         let alpha = self.dynamics.mass_damping;
         for (i, p) in x.iter().enumerate() {
             let m = self.masses[i];
-            let force = m * (p - terms.predicted[i]) / (h * h) - m * g + alpha * m * (p - terms.start[i]) / h;
+            let mut force =
+                m * (p - terms.predicted[i]) / (h * h) - m * g + alpha * m * (p - terms.start[i]) / h;
+            if let Some(wind) = terms.wind.get(i) {
+                force -= wind;
+            }
             let diagonal = m / (h * h) + alpha * m / h;
             for k in 0..3 {
                 a.gradient[3 * i + k] += force[k];

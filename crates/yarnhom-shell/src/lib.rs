@@ -19,6 +19,7 @@ pub mod simulate;
 pub mod statics;
 #[cfg(test)]
 mod test_support;
+pub mod wind;
 
 pub use elastic::{Assembly, ElasticModel};
 pub use integrator::{Dynamics, Handle, Motion, Simulation, StepStats};
@@ -26,3 +27,4 @@ pub use linear_solver::{LinearSolver, LinearSolves};
 pub use material::{HingeBending, ShellMaterial, Stiffening, StvkNeoHookean, open_material};
 pub use mesh::ShellMesh;
 pub use scene::Scene;
+pub use wind::Wind;

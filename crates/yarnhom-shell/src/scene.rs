@@ -14,6 +14,7 @@ use crate::elastic::NewtonMatrix;
 use crate::integrator::{Dynamics, Handle, Motion};
 use crate::linear_solver::LinearSolver;
 use crate::mesh::ShellMesh;
+use crate::wind::Wind;
 
 /// A simulation scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,6 +39,9 @@ pub struct Scene {
     pub mass_damping: f64,
     /// Rayleigh stiffness damping `β` (s).
     pub stiffness_damping: f64,
+    /// Air drag (ARCSim's `wind`, [`crate::wind`]); none when absent.
+    #[serde(default)]
+    pub wind: Wind,
     /// Handles.
     pub handles: Vec<HandleSpec>,
     /// Motions: keyframes `(time_s, translation_m)` referenced by handles.
@@ -115,8 +119,10 @@ pub const BUILTINS: [&str; 3] = ["stretch-x", "stretch-y", "drape"];
 impl Scene {
     /// A built-in: the published stockinette stretch (`stock_stretchX.json`, `stock_stretchY.json`:
     /// bars on opposite sides, 67% long, 7% deep, 16% inset, pulled 3.5 cm each over 0.4 s, 1 s
-    /// in all) and drape (`stock_drapeX.json`: held in two 1 cm spheres at x = -10 cm, y = ±10 cm,
-    /// over a 3 cm sphere 4 cm below the centre, friction 0.052, 2 s).
+    /// in all; stiffness damping 1 ms, air drag density 10 kg/m³) and drape (`stock_drapeX.json`:
+    /// held in two 1 cm spheres at x = -10 cm, y = ±10 cm, over a 3 cm sphere 4 cm below the
+    /// centre, friction 0.052, 2 s; stiffness damping 2 ms, air drag density 7.5 kg/m³). As in
+    /// ARCSim, no Rayleigh mass damping ([`crate::arcsim_scene`]).
     pub fn builtin(name: &str) -> Result<Self, SceneError> {
         let base = Scene {
             name: name.into(),
@@ -126,8 +132,9 @@ impl Scene {
             frame_time_s: 0.0167,
             steps_per_frame: 4,
             gravity: [0.0, 0.0, -9.81],
-            mass_damping: 1.0,
+            mass_damping: 0.0,
             stiffness_damping: 1e-3,
+            wind: Wind { density_kg_m3: 10.0, ..Wind::default() },
             handles: Vec::new(),
             motions: Vec::new(),
             obstacles: Vec::new(),
@@ -165,6 +172,7 @@ impl Scene {
             "drape" => Ok(Scene {
                 end_time_s: 2.0,
                 stiffness_damping: 2e-3,
+                wind: Wind { density_kg_m3: 7.5, ..Wind::default() },
                 handles: [-0.1, 0.1]
                     .map(|y| HandleSpec::Sphere { center: [-0.1, y, 0.0], radius: 0.01, motion: None })
                     .to_vec(),
@@ -192,6 +200,13 @@ impl Scene {
         }
         if !(self.end_time_s > 0.0 && self.frame_time_s > 0.0 && self.steps_per_frame > 0) {
             return bad("end_time_s, frame_time_s and steps_per_frame must be positive".into());
+        }
+        let w = &self.wind;
+        if !(w.density_kg_m3 >= 0.0 && w.drag_kg_m2_s >= 0.0 && w.velocity_m_s.iter().all(|v| v.is_finite()))
+        {
+            return bad(
+                "wind: density_kg_m3 and drag_kg_m2_s must be non-negative, velocity_m_s finite".into()
+            );
         }
         for (k, h) in self.handles.iter().enumerate() {
             let motion = match h {
@@ -282,6 +297,7 @@ impl Scene {
             gravity: self.gravity,
             mass_damping: self.mass_damping,
             stiffness_damping: self.stiffness_damping,
+            wind: self.wind,
             max_newton_iterations: self.max_newton_iterations,
             tolerance_m: self.tolerance_m,
             newton_matrix: self.newton_matrix,
@@ -320,5 +336,20 @@ mod tests {
         let bad = text.replace("\"steps_per_frame\": 4", "\"steps_per_frame\": 0");
         assert!(Scene::from_json(&bad).expect_err("invalid").to_string().contains("steps_per_frame"));
         assert!(matches!(Scene::builtin("wave"), Err(SceneError::UnknownBuiltin(_))));
+    }
+
+    #[test]
+    fn scene_files_without_wind_load_without_air_drag() {
+        let mut json = serde_json::to_value(Scene::builtin("drape").expect("builtin")).expect("json");
+        assert_eq!(json["wind"]["density_kg_m3"], 7.5);
+        json.as_object_mut().expect("object").remove("wind");
+        let old = Scene::from_json(&json.to_string()).expect("parses");
+        assert_eq!(old.wind, Wind::default());
+        assert!(old.wind.is_none() && old.dynamics().wind.is_none());
+        json["wind"] = serde_json::json!({"drag_kg_m2_s": 0.2});
+        let partial = Scene::from_json(&json.to_string()).expect("parses");
+        assert_eq!(partial.wind, Wind { drag_kg_m2_s: 0.2, ..Wind::default() });
+        json["wind"] = serde_json::json!({"density_kg_m3": -1.0});
+        assert!(Scene::from_json(&json.to_string()).expect_err("invalid").to_string().contains("wind"));
     }
 }

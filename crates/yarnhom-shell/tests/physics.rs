@@ -263,3 +263,42 @@ fn conjugate_gradients_take_short_steps_to_the_states_cholesky_takes() {
     let (_, long_steps) = run(LinearSolver::Auto, 4);
     assert!(long_steps.factorizations >= steps && long_steps.cg_iterations == 0, "{long_steps:?}");
 }
+
+/// The published `stock_drapeX.json` with `stock1` at 50 x 50 vertices to `t = 0.23 s`, at 4 and
+/// 16 steps per frame: with and without its air drag (`"wind": {"density": 7.5}`) and Rayleigh
+/// mass damping. Per variant the mean vertical displacement and the RMS displacement of the
+/// vertices, and their RMS distance from the run as imported before the wind was (no wind,
+/// `α = 1/s`).
+#[test]
+#[ignore = "about 3 minutes: cargo test -p yarnhom-shell --test physics -- --ignored --nocapture"]
+fn the_published_drape_with_and_without_its_air_drag() {
+    let path = format!("{}/../../../shared/data/hylc-scenes/stock_drapeX.json", env!("CARGO_MANIFEST_DIR"));
+    let imported = Scene::load(&path).expect("published scene");
+    assert_eq!((imported.wind.density_kg_m3, imported.mass_damping), (7.5, 0.0));
+    let rms = |a: &[Vector3<f64>], b: &[Vector3<f64>]| {
+        (a.iter().zip(b).map(|(p, q)| (p - q).norm_squared()).sum::<f64>() / a.len() as f64).sqrt()
+    };
+    for steps in [4, 16] {
+        let mut before: Option<Vec<Vector3<f64>>> = None;
+        for (density, alpha) in [(0.0, 1.0), (7.5, 0.0), (7.5, 1.0), (0.0, 0.0)] {
+            let mut s = imported.clone();
+            (s.steps_per_frame, s.wind.density_kg_m3, s.mass_damping) = (steps, density, alpha);
+            let mut sim = prepare(&s, published("stock1")).expect("scene");
+            let start = sim.positions.clone();
+            run_steps(&mut sim, (0.23 / s.dt_s()).round() as usize);
+            let sinking =
+                start.iter().zip(&sim.positions).map(|(p, q)| p.z - q.z).sum::<f64>() / start.len() as f64;
+            eprintln!(
+                "{steps} steps per frame, wind {density}, alpha {alpha}: t = {:.4} s, mean drop {:.1} mm, \
+                 RMS displacement {:.1} mm, RMS from no wind and alpha 1: {:.1} mm",
+                sim.time_s,
+                1e3 * sinking,
+                1e3 * rms(&start, &sim.positions),
+                1e3 * before.as_deref().map_or(0.0, |b| rms(b, &sim.positions)),
+            );
+            let moved = rms(&start, &sim.positions);
+            assert!(moved > 0.05 && moved < 0.2, "the cloth falls and swings: {moved} m");
+            before.get_or_insert(sim.positions);
+        }
+    }
+}
