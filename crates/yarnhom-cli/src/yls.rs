@@ -1,13 +1,13 @@
 //! `yarnhom yls ...`: yarn-level simulation of whole swatches.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand};
 use yarnhom_artifacts::open::{open_artifact, open_pattern_and_model};
 use yarnhom_artifacts::{GlueSettings, Swatch};
-use yarnhom_trace::TraceMetadata;
+use yarnhom_trace::{TraceMetadata, is_stdio};
 use yarnhom_yls::dynamics::Simulation;
-use yarnhom_yls::record::record_run;
+use yarnhom_yls::record::{record_resumable, record_run};
 use yarnhom_yls::run::{RunSettings, place};
 use yarnhom_yls::swatch::{SwatchSize, cut_swatch};
 use yarnhom_yls::variations::{Variation, shard_sequences};
@@ -84,6 +84,11 @@ pub struct RunArgs {
     /// Backward Euler steps per frame.
     #[arg(long, default_value_t = RunSettings::default().steps_per_frame)]
     pub steps_per_frame: u32,
+    /// Save the state every this many frames (`T.checkpoint`, the frames so far as
+    /// `T.partNNNN`): a rerun of a killed run with the same arguments continues from there, to
+    /// the bit; 0: never (as for `-o -`).
+    #[arg(long, default_value_t = 50)]
+    pub checkpoint_every: u64,
     /// Rate of Kaldor's damping of non-rigid motion (1/s).
     #[arg(long, default_value_t = RunSettings::default().damping_rate_per_s, value_parser = non_negative)]
     pub damping: f64,
@@ -193,15 +198,26 @@ fn run_to_trace(
     metadata: &TraceMetadata,
 ) -> anyhow::Result<()> {
     let mut simulation = Simulation::new(&placed)?;
-    let mut trace = open_trace(output, metadata)?;
     let frames = args.frames.unwrap_or_else(|| (scene.end_time_s / scene.frame_time_s).round() as u64);
     let bar = progress_bar(frames, "frames");
-    record_run(&mut trace, &mut simulation, &swatch.name, frames, scene.frame_time_s, args.steps_per_frame, |r| {
+    let progress = |r: &yarnhom_yls::run::FrameReport| {
         bar.set_position(r.frame);
         bar.set_message(format!("closest {:.2} r", r.closest_distance_radii));
-    })?;
+    };
+    let (name, dt, steps) = (&swatch.name, scene.frame_time_s, args.steps_per_frame);
+    if args.checkpoint_every == 0 || is_stdio(output) {
+        let mut trace = open_trace(output, metadata)?;
+        record_run(&mut trace, &mut simulation, name, frames, dt, steps, progress)?;
+        finish_trace(Some(trace), Some(output))?;
+    } else {
+        let path = Path::new(output);
+        let every = args.checkpoint_every;
+        let resumed = record_resumable(path, metadata, &mut simulation, name, frames, dt, steps, every, progress)?;
+        if resumed > 0 {
+            eprintln!("resumed {output} at frame {resumed}");
+        }
+    }
     bar.finish_and_clear();
-    finish_trace(Some(trace), Some(output))?;
     eprintln!("simulated {} s of {} yarns, {} vertices", simulation.time_s(), swatch.yarns.len(), swatch.positions_m.len());
     Ok(())
 }

@@ -281,6 +281,22 @@ impl Rod {
         (energy, gradient, triplets)
     }
 
+    /// The reference frames of the bending-twisting elements, which
+    /// [`Rod::update_references`] moves with the rod (a simulation's state besides its DOFs).
+    pub fn references(&self) -> &[BendTwistReference] {
+        &self.references
+    }
+
+    /// Put back reference frames read by [`Rod::references`] from this rod; `Err(expected
+    /// count)` if their number differs.
+    pub fn set_references(&mut self, references: &[BendTwistReference]) -> Result<(), usize> {
+        if references.len() != self.references.len() {
+            return Err(self.references.len());
+        }
+        self.references = references.to_vec();
+        Ok(())
+    }
+
     /// Move the reference frames to configuration `q` (time-parallel transport) and record the
     /// reference twists there; call after every accepted step.
     pub fn update_references(&mut self, q: &DVector<f64>) {

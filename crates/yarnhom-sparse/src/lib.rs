@@ -193,6 +193,22 @@ impl SpdSolver {
         Ok(())
     }
 
+    /// The size and lower-triangle positions of the analysed pattern, if any: with
+    /// [`SpdSolver::with_pattern`] they restore a solver whose factorizations are those of this
+    /// one, to the bit (the fill-reducing ordering depends on the pattern analysed).
+    pub fn analysed_pattern(&self) -> Option<(usize, Vec<(usize, usize)>)> {
+        self.analysis.as_ref().map(|a| (a.size(), a.entries().collect()))
+    }
+
+    /// A solver with the `n x n` pattern `entries` analysed (see [`SpdSolver::analysed_pattern`]).
+    pub fn with_pattern(n: usize, entries: &[(usize, usize)]) -> Result<Self, NotPositiveDefinite> {
+        if entries.iter().any(|&(i, j)| i >= n || j > i) {
+            return Err(NotPositiveDefinite);
+        }
+        let analysis = Analysis::new(n, entries.iter().copied())?;
+        Ok(SpdSolver { analysis: Some(analysis), symbolic_analyses: 1, ..SpdSolver::default() })
+    }
+
     /// Solve in place for the `columns` right-hand sides stored column-major in `rhs`.
     pub fn solve_in_place(&self, rhs: &mut [f64], columns: usize) {
         if let Some(factor) = &self.factor {

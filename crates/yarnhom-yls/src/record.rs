@@ -5,10 +5,16 @@
 
 use std::collections::BTreeMap;
 
-use yarnhom_trace::{Scalars, SolverStep, TraceError, TraceSink, YarnFrame, YarnNodes};
+use std::path::{Path, PathBuf};
 
-use crate::dynamics::Simulation;
-use crate::run::FrameReport;
+use serde::{Deserialize, Serialize};
+use yarnhom_artifacts::write_atomic;
+use yarnhom_trace::{
+    Scalars, SolverStep, TraceError, TraceMetadata, TraceSink, YarnFrame, YarnNodes, open_records,
+};
+
+use crate::dynamics::{Checkpoint, Simulation};
+use crate::run::{FrameReport, RunError};
 
 /// The yarns of `simulation` as graph nodes of yarn set `name`: its current positions as rest
 /// positions, `HANDLE` for the vertices handles hold and `NORMAL` for the others, and every
@@ -110,6 +116,127 @@ pub fn record_frame(
     sink.end_frame()
 }
 
+/// Where a resumable recording keeps its state while it runs: `T.checkpoint` and the traces
+/// of the finished stretches of frames, `T.partNNNN`.
+fn checkpoint_path(trace: &Path) -> PathBuf {
+    PathBuf::from(format!("{}.checkpoint", trace.display()))
+}
+
+fn part_path(trace: &Path, part: u32) -> PathBuf {
+    PathBuf::from(format!("{}.part{part:04}", trace.display()))
+}
+
+/// What a resumable recording saved after its last finished stretch of frames.
+#[derive(Serialize, Deserialize)]
+struct Saved {
+    /// The run it belongs to (its trace metadata).
+    run: String,
+    /// The last frame recorded.
+    frame: u64,
+    /// Stretches recorded (`T.part0000` ...).
+    parts: u32,
+    /// The simulation at `frame`.
+    state: Checkpoint,
+}
+
+/// Why a resumable recording stopped.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The run failed.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A trace could not be written or read.
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// The checkpoint could not be written or read.
+    #[error("{path}: {problem}")]
+    Checkpoint {
+        /// The checkpoint file.
+        path: String,
+        /// What went wrong.
+        problem: String,
+    },
+}
+
+/// Record `frames` frames of `simulation` (from its start) into the trace at `path`, as
+/// [`record_run`] does, resumable after a kill: every `every` frames the frames so far are
+/// finished as a part trace beside `path` and the simulation's whole state is saved to
+/// `path.checkpoint`; a later call with the same `metadata` continues from the last
+/// checkpoint, to the bit. At the end the parts are merged into `path` and removed. Returns the
+/// frame it started from (0 unless resumed).
+#[allow(clippy::too_many_arguments)]
+pub fn record_resumable(
+    path: &Path,
+    metadata: &TraceMetadata,
+    simulation: &mut Simulation,
+    name: &str,
+    frames: u64,
+    frame_time_s: f64,
+    steps_per_frame: u32,
+    every: u64,
+    mut progress: impl FnMut(&FrameReport),
+) -> Result<u64, RecordError> {
+    let run_id = format!("{:?}", metadata.entries);
+    let saved = read_saved(&checkpoint_path(path), &run_id)?;
+    let (mut first, mut part) = match &saved {
+        Some(s) => {
+            simulation.restore(&s.state).map_err(|e| checkpoint_error(path, e))?;
+            (s.frame + 1, s.parts)
+        }
+        None => (0, 0),
+    };
+    let started = first;
+    while first <= frames {
+        let last = (first + every.max(1) - 1).min(frames);
+        let part_file = part_path(path, part);
+        let mut sink = TraceSink::open(&part_file.display().to_string(), metadata)?;
+        crate::run::run(simulation, first..=last, frame_time_s, steps_per_frame, |report, sim| {
+            record_frame(&mut sink, report, sim, name).map_err(|e| e.to_string())?;
+            progress(report);
+            Ok(())
+        })?;
+        sink.finish()?;
+        part += 1;
+        let saved = Saved { run: run_id.clone(), frame: last, parts: part, state: simulation.checkpoint() };
+        let bytes = rmp_serde::to_vec_named(&saved).map_err(|e| checkpoint_error(path, e))?;
+        write_atomic(checkpoint_path(path), bytes).map_err(|e| checkpoint_error(path, e))?;
+        first = last + 1;
+    }
+    merge_parts(path, metadata, part)?;
+    Ok(started)
+}
+
+/// The saved state of the run `run_id`, if a checkpoint is there; a checkpoint of another run
+/// is an error (delete it to start over).
+fn read_saved(path: &Path, run_id: &str) -> Result<Option<Saved>, RecordError> {
+    let bytes = match std::fs::read(path) {
+        Ok(bytes) => bytes,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(checkpoint_error(path, e)),
+    };
+    let saved: Saved = rmp_serde::from_slice(&bytes).map_err(|e| checkpoint_error(path, e))?;
+    if saved.run != run_id {
+        return Err(checkpoint_error(path, "the checkpoint of another run (other scene, swatch or settings): delete it to start over"));
+    }
+    Ok(Some(saved))
+}
+
+/// Merge the `parts` part traces into the trace at `path`, then remove them and the checkpoint.
+fn merge_parts(path: &Path, metadata: &TraceMetadata, parts: u32) -> Result<(), RecordError> {
+    let files: Vec<String> = (0..parts).map(|k| part_path(path, k).display().to_string()).collect();
+    let mut sink = TraceSink::open(&path.display().to_string(), metadata)?;
+    sink.merge(files.iter().map(|f| open_records(f)).collect::<Result<Vec<_>, _>>()?)?;
+    sink.finish()?;
+    for file in files.iter().map(PathBuf::from).chain([checkpoint_path(path)]) {
+        std::fs::remove_file(&file).map_err(|e| checkpoint_error(&file, e))?;
+    }
+    Ok(())
+}
+
+fn checkpoint_error(path: &Path, problem: impl std::fmt::Display) -> RecordError {
+    RecordError::Checkpoint { path: path.display().to_string(), problem: problem.to_string() }
+}
+
 /// Run `simulation` for `frames` frames of `frame_time_s` (each of `steps_per_frame` steps),
 /// recording every frame, the initial one included, as yarn set `name` on `sink`; `progress`
 /// sees each frame's report after it is recorded.
@@ -121,8 +248,8 @@ pub fn record_run(
     frame_time_s: f64,
     steps_per_frame: u32,
     mut progress: impl FnMut(&FrameReport),
-) -> Result<(), crate::run::RunError> {
-    crate::run::run(simulation, frames, frame_time_s, steps_per_frame, |report, sim| {
+) -> Result<(), RunError> {
+    crate::run::run(simulation, 0..=frames, frame_time_s, steps_per_frame, |report, sim| {
         record_frame(sink, report, sim, name).map_err(|e| e.to_string())?;
         progress(report);
         Ok(())

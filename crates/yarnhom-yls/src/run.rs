@@ -207,22 +207,26 @@ pub struct FrameReport {
     pub closest_distance_radii: f64,
 }
 
-/// Run `simulation` from its current state for `frames` output frames of `frame_time_s`, each
-/// of `steps_per_frame` steps, calling `on_frame` at the start (frame 0) and after each frame.
+/// Run `simulation` through output `frames` of `frame_time_s`, each of `steps_per_frame`
+/// steps, calling `on_frame` after each: frame 0 is the current state (reported as it is);
+/// frame `k > 0` is reached by stepping from frame `k - 1`, where the simulation must be.
 pub fn run(
     simulation: &mut Simulation,
-    frames: u64,
+    frames: std::ops::RangeInclusive<u64>,
     frame_time_s: f64,
     steps_per_frame: u32,
     mut on_frame: impl FnMut(&FrameReport, &Simulation) -> Result<(), String>,
 ) -> Result<(), RunError> {
     let time_step_s = frame_time_s / f64::from(steps_per_frame);
-    on_frame(&frame_report(simulation, 0, vec![]), simulation).map_err(RunError::Output)?;
-    for frame in 1..=frames {
-        let steps = (0..steps_per_frame)
-            .map(|_| simulation.step(time_step_s))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|error| RunError::Step { frame, error })?;
+    for frame in frames {
+        let steps = if frame == 0 {
+            vec![]
+        } else {
+            (0..steps_per_frame)
+                .map(|_| simulation.step(time_step_s))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|error| RunError::Step { frame, error })?
+        };
         on_frame(&frame_report(simulation, frame, steps), simulation).map_err(RunError::Output)?;
     }
     Ok(())

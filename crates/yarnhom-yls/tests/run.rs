@@ -47,7 +47,7 @@ fn stretch_bars_grip_the_yarns_near_their_sides_and_pull_them_apart() {
     };
     let start = width_at(&simulation);
     let mut closest = f64::INFINITY;
-    run(&mut simulation, 2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
+    run(&mut simulation, 0..=2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
         closest = closest.min(report.closest_distance_radii);
         Ok(())
     })
@@ -74,7 +74,7 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     let path = dir.path().join("run.mcap");
     let path = path.to_str().expect("utf-8");
     let mut sink = TraceSink::open(path, &TraceMetadata::new("test", "0")).expect("opens");
-    run(&mut simulation, 2, scene.frame_time_s, 2, |report, s| {
+    run(&mut simulation, 0..=2, scene.frame_time_s, 2, |report, s| {
         record_frame(&mut sink, report, s, "stock").map_err(|e| e.to_string())
     })
     .expect("runs");
@@ -125,4 +125,51 @@ fn box_obstacles_and_bad_settings_are_refused() {
     ] {
         assert!(matches!(place(&swatch, &scene, &settings), Err(RunError::Settings(_))));
     }
+}
+
+/// The yarn frames of the trace at `path`.
+fn yarn_frames(path: &std::path::Path) -> Vec<yarnhom_trace::YarnFrame> {
+    TraceReader::new(std::fs::File::open(path).expect("the trace"))
+        .filter_map(|m| match m.expect("reads") {
+            TraceMessage::Yarns(f) => Some(f),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn a_killed_recording_resumes_from_its_checkpoint_to_the_same_bits() {
+    use yarnhom_yls::record::record_resumable;
+    let swatch = stock_swatch([2, 2]);
+    let scene = yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in");
+    let placed = place(&swatch, &scene, &RunSettings::default()).expect("places");
+    let metadata = TraceMetadata::new("test", "0").with_entry("scene", "stretch-x");
+    let dir = tempfile::tempdir().expect("tempdir");
+    let record = |path: &std::path::Path, every: u64, kill_at: Option<u64>| {
+        let mut simulation = Simulation::new(&placed).expect("a valid scene");
+        record_resumable(path, &metadata, &mut simulation, "stock", 3, scene.frame_time_s, 4, every, |r| {
+            assert!(Some(r.frame) != kill_at, "killed at frame {}", r.frame);
+        })
+    };
+    let straight = dir.path().join("straight.mcap");
+    assert_eq!(record(&straight, 100, None).expect("records"), 0);
+
+    let resumed = dir.path().join("resumed.mcap");
+    let killed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| record(&resumed, 1, Some(2))));
+    assert!(killed.is_err(), "the first run is killed");
+    assert!(!resumed.exists());
+    assert!(dir.path().join("resumed.mcap.checkpoint").exists(), "frames 0 and 1 were checkpointed");
+    assert_eq!(record(&resumed, 1, None).expect("resumes"), 2, "from frame 2");
+    assert!(!dir.path().join("resumed.mcap.checkpoint").exists() && !dir.path().join("resumed.mcap.part0000").exists());
+
+    let (a, b) = (yarn_frames(&straight), yarn_frames(&resumed));
+    assert_eq!(a.len(), 4);
+    assert_eq!(a, b, "the resumed run's frames are the uninterrupted run's, to the bit");
+
+    let other = TraceMetadata::new("test", "0").with_entry("scene", "drape");
+    let mut simulation = Simulation::new(&placed).expect("a valid scene");
+    std::fs::write(dir.path().join("x.mcap.checkpoint"), std::fs::read(dir.path().join("straight.mcap")).expect("bytes"))
+        .expect("writes");
+    let error = record_resumable(&dir.path().join("x.mcap"), &other, &mut simulation, "stock", 1, 0.01, 1, 1, |_| {});
+    assert!(error.is_err(), "a file that is not a checkpoint is refused");
 }

@@ -36,6 +36,7 @@
 //!   element order; results are the same to the bit for any number of rayon threads.
 
 mod caps;
+mod checkpoint;
 mod contact;
 mod damping;
 mod handles;
@@ -47,6 +48,7 @@ mod springs;
 mod step;
 mod system;
 
+pub use checkpoint::Checkpoint;
 pub use damping::Damping;
 pub use handles::{Handle, Keyframe};
 pub use input::{InputError, YarnInput};

@@ -12,9 +12,9 @@ use super::system::{Scene, System};
 
 /// A scene being simulated.
 pub struct Simulation {
-    system: System,
-    state: State,
-    solver: SpdSolver,
+    pub(super) system: System,
+    pub(super) state: State,
+    pub(super) solver: SpdSolver,
 }
 
 impl Simulation {
