@@ -203,7 +203,7 @@ fn the_objective_on_the_generated_acrylic_stockinette_is_continuous_at_round_off
 /// comfort error both directions reach at once. A swatch where that error stays above 10% at
 /// every point has at most one of its two directions within 10%.
 #[test]
-#[ignore = "about 15 min on 2 cores: 112 estimated rest shapes and their uniaxial tests"]
+#[ignore = "about 8 min on 2 cores: 112 estimated rest shapes and their uniaxial tests"]
 fn the_own_stitch_tiles_fit_weft_and_warp_within_ten_percent_at_once_nowhere() {
     let settings = YarnFitSettings::default();
     let mut best_per_swatch = Vec::new();

@@ -18,7 +18,7 @@ use yarnhom_rve::sweep::{Sweep, Swept};
 use yarnhom_trace::TraceMetadata;
 
 use crate::Outcome;
-use crate::args::{parse_axis, parse_interval};
+use crate::args::{parse_axis, parse_interval, parse_shard};
 use crate::output::{finish_trace, open_trace, print_summary, progress_bar, write_artifact, wrote};
 
 #[derive(Debug, Args)]
@@ -49,8 +49,8 @@ pub struct SampleArgs {
     pub plane_ranges: Vec<PlaneRange>,
     /// Compute this shard `K/N` of the sweep lines only (0 <= K < N); merge the shards with
     /// `yarnhom grid merge`.
-    #[arg(long, value_name = "K/N", value_parser = crate::args::parse_shard)]
-    pub shard: Option<(u32, u32)>,
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
     /// Store every sample's equilibrium geometry (for yarn detail, Ch. 5).
     #[arg(long)]
     pub geometry: bool,
@@ -120,7 +120,8 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
     let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
     let plan = SamplePlan::thesis(&plan_ranges(&args)?, args.n1d, args.n2d)?;
-    let shard = args.shard.map(|(index, count)| GridShard { index, count });
+    let shard = args.shard.as_deref().map(parse_shard).transpose().map_err(|e| anyhow::anyhow!("--shard {e}"))?;
+    let shard = shard.map(|(index, count)| GridShard { index, count });
     let options = SampleOptions {
         max_iterations: args.max_iterations,
         stress: !args.no_stress,
