@@ -8,7 +8,7 @@ use yarnhom_artifacts::{GlueSettings, Swatch};
 use yarnhom_trace::{TraceMetadata, is_stdio};
 use yarnhom_yls::dynamics::Simulation;
 use yarnhom_yls::record::{record_resumable, record_run};
-use yarnhom_yls::run::{RunSettings, place};
+use yarnhom_yls::run::{Frames, RunSettings, place};
 use yarnhom_yls::swatch::{SwatchSize, cut_swatch};
 use yarnhom_yls::variations::{Variation, shard_sequences};
 
@@ -204,15 +204,15 @@ fn run_to_trace(
         bar.set_position(r.frame);
         bar.set_message(format!("closest {:.2} r", r.closest_distance_radii));
     };
-    let (name, dt, steps) = (&swatch.name, scene.frame_time_s, args.steps_per_frame);
+    let plan = Frames { count: frames, frame_time_s: scene.frame_time_s, steps_per_frame: args.steps_per_frame };
     if args.checkpoint_every == 0 || is_stdio(output) {
         let mut trace = open_trace(output, metadata)?;
-        record_run(&mut trace, &mut simulation, name, frames, dt, steps, progress)?;
+        record_run(&mut trace, &mut simulation, &swatch.name, &plan, progress)?;
         finish_trace(Some(trace), Some(output))?;
     } else {
         let path = Path::new(output);
         let every = args.checkpoint_every;
-        let resumed = record_resumable(path, metadata, &mut simulation, name, frames, dt, steps, every, progress)?;
+        let resumed = record_resumable(path, metadata, &mut simulation, &swatch.name, &plan, every, progress)?;
         if resumed > 0 {
             eprintln!("resumed {output} at frame {resumed}");
         }

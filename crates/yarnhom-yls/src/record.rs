@@ -14,7 +14,7 @@ use yarnhom_trace::{
 };
 
 use crate::dynamics::{Checkpoint, Simulation};
-use crate::run::{FrameReport, RunError};
+use crate::run::{FrameReport, Frames, RunError};
 
 /// The yarns of `simulation` as graph nodes of yarn set `name`: its current positions as rest
 /// positions, `HANDLE` for the vertices handles hold and `NORMAL` for the others, and every
@@ -158,21 +158,18 @@ pub enum RecordError {
     },
 }
 
-/// Record `frames` frames of `simulation` (from its start) into the trace at `path`, as
+/// Record the frames of `plan` of `simulation` (from its start) into the trace at `path`, as
 /// [`record_run`] does, resumable after a kill: every `every` frames the frames so far are
 /// finished as a part trace beside `path` and the simulation's whole state is saved to
 /// `path.checkpoint`; a later call with the same `metadata` continues from the last
 /// checkpoint, to the bit. At the end the parts are merged into `path` and removed. Returns the
 /// frame it started from (0 unless resumed).
-#[allow(clippy::too_many_arguments)]
 pub fn record_resumable(
     path: &Path,
     metadata: &TraceMetadata,
     simulation: &mut Simulation,
     name: &str,
-    frames: u64,
-    frame_time_s: f64,
-    steps_per_frame: u32,
+    plan: &Frames,
     every: u64,
     mut progress: impl FnMut(&FrameReport),
 ) -> Result<u64, RecordError> {
@@ -186,11 +183,11 @@ pub fn record_resumable(
         None => (0, 0),
     };
     let started = first;
-    while first <= frames {
-        let last = (first + every.max(1) - 1).min(frames);
+    while first <= plan.count {
+        let last = (first + every.max(1) - 1).min(plan.count);
         let part_file = part_path(path, part);
         let mut sink = TraceSink::open(&part_file.display().to_string(), metadata)?;
-        crate::run::run(simulation, first..=last, frame_time_s, steps_per_frame, |report, sim| {
+        crate::run::run(simulation, first..=last, plan, |report, sim| {
             record_frame(&mut sink, report, sim, name).map_err(|e| e.to_string())?;
             progress(report);
             Ok(())
@@ -237,19 +234,17 @@ fn checkpoint_error(path: &Path, problem: impl std::fmt::Display) -> RecordError
     RecordError::Checkpoint { path: path.display().to_string(), problem: problem.to_string() }
 }
 
-/// Run `simulation` for `frames` frames of `frame_time_s` (each of `steps_per_frame` steps),
-/// recording every frame, the initial one included, as yarn set `name` on `sink`; `progress`
+/// Run `simulation` through the frames of `plan`, recording every frame, the initial one
+/// included, as yarn set `name` on `sink`; `progress`
 /// sees each frame's report after it is recorded.
 pub fn record_run(
     sink: &mut TraceSink,
     simulation: &mut Simulation,
     name: &str,
-    frames: u64,
-    frame_time_s: f64,
-    steps_per_frame: u32,
+    plan: &Frames,
     mut progress: impl FnMut(&FrameReport),
 ) -> Result<(), RunError> {
-    crate::run::run(simulation, 0..=frames, frame_time_s, steps_per_frame, |report, sim| {
+    crate::run::run(simulation, 0..=plan.count, plan, |report, sim| {
         record_frame(sink, report, sim, name).map_err(|e| e.to_string())?;
         progress(report);
         Ok(())

@@ -192,6 +192,18 @@ fn check_settings(settings: &RunSettings) -> Result<(), RunError> {
     Ok(())
 }
 
+/// The output frames of a run: how many after the initial one, how far apart, and the
+/// backward Euler steps between two.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frames {
+    /// Frames after frame 0.
+    pub count: u64,
+    /// Time between frames (s).
+    pub frame_time_s: f64,
+    /// Steps per frame.
+    pub steps_per_frame: u32,
+}
+
 /// What happened up to an output frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameReport {
@@ -207,22 +219,21 @@ pub struct FrameReport {
     pub closest_distance_radii: f64,
 }
 
-/// Run `simulation` through output `frames` of `frame_time_s`, each of `steps_per_frame`
-/// steps, calling `on_frame` after each: frame 0 is the current state (reported as it is);
+/// Run `simulation` through output `frames` of `plan` (its count aside), calling `on_frame`
+/// after each: frame 0 is the current state (reported as it is);
 /// frame `k > 0` is reached by stepping from frame `k - 1`, where the simulation must be.
 pub fn run(
     simulation: &mut Simulation,
     frames: std::ops::RangeInclusive<u64>,
-    frame_time_s: f64,
-    steps_per_frame: u32,
+    plan: &Frames,
     mut on_frame: impl FnMut(&FrameReport, &Simulation) -> Result<(), String>,
 ) -> Result<(), RunError> {
-    let time_step_s = frame_time_s / f64::from(steps_per_frame);
+    let time_step_s = plan.frame_time_s / f64::from(plan.steps_per_frame);
     for frame in frames {
         let steps = if frame == 0 {
             vec![]
         } else {
-            (0..steps_per_frame)
+            (0..plan.steps_per_frame)
                 .map(|_| simulation.step(time_step_s))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|error| RunError::Step { frame, error })?

@@ -6,7 +6,7 @@ use yarnhom_artifacts::{GlueSettings, Swatch, YarnModel, pyp};
 use yarnhom_trace::{TraceMessage, TraceMetadata, TraceReader, TraceSink};
 use yarnhom_yls::dynamics::Simulation;
 use yarnhom_yls::record::record_frame;
-use yarnhom_yls::run::{RunError, RunSettings, place, run};
+use yarnhom_yls::run::{Frames, RunError, RunSettings, place, run};
 use yarnhom_yls::swatch::{SwatchSize, cut_swatch};
 
 fn stock_swatch(tiles: [u32; 2]) -> Swatch {
@@ -47,7 +47,8 @@ fn stretch_bars_grip_the_yarns_near_their_sides_and_pull_them_apart() {
     };
     let start = width_at(&simulation);
     let mut closest = f64::INFINITY;
-    run(&mut simulation, 0..=2, scene.frame_time_s, settings.steps_per_frame, |report, _| {
+    let plan = Frames { count: 2, frame_time_s: scene.frame_time_s, steps_per_frame: settings.steps_per_frame };
+    run(&mut simulation, 0..=2, &plan, |report, _| {
         closest = closest.min(report.closest_distance_radii);
         Ok(())
     })
@@ -74,7 +75,8 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     let path = dir.path().join("run.mcap");
     let path = path.to_str().expect("utf-8");
     let mut sink = TraceSink::open(path, &TraceMetadata::new("test", "0")).expect("opens");
-    run(&mut simulation, 0..=2, scene.frame_time_s, 2, |report, s| {
+    let plan = Frames { count: 2, frame_time_s: scene.frame_time_s, steps_per_frame: 2 };
+    run(&mut simulation, 0..=2, &plan, |report, s| {
         record_frame(&mut sink, report, s, "stock").map_err(|e| e.to_string())
     })
     .expect("runs");
@@ -147,7 +149,8 @@ fn a_killed_recording_resumes_from_its_checkpoint_to_the_same_bits() {
     let dir = tempfile::tempdir().expect("tempdir");
     let record = |path: &std::path::Path, every: u64, kill_at: Option<u64>| {
         let mut simulation = Simulation::new(&placed).expect("a valid scene");
-        record_resumable(path, &metadata, &mut simulation, "stock", 3, scene.frame_time_s, 4, every, |r| {
+        let plan = Frames { count: 3, frame_time_s: scene.frame_time_s, steps_per_frame: 4 };
+        record_resumable(path, &metadata, &mut simulation, "stock", &plan, every, |r| {
             assert!(Some(r.frame) != kill_at, "killed at frame {}", r.frame);
         })
     };
@@ -170,6 +173,7 @@ fn a_killed_recording_resumes_from_its_checkpoint_to_the_same_bits() {
     let mut simulation = Simulation::new(&placed).expect("a valid scene");
     std::fs::write(dir.path().join("x.mcap.checkpoint"), std::fs::read(dir.path().join("straight.mcap")).expect("bytes"))
         .expect("writes");
-    let error = record_resumable(&dir.path().join("x.mcap"), &other, &mut simulation, "stock", 1, 0.01, 1, 1, |_| {});
+    let plan = Frames { count: 1, frame_time_s: 0.01, steps_per_frame: 1 };
+    let error = record_resumable(&dir.path().join("x.mcap"), &other, &mut simulation, "stock", &plan, 1, |_| {});
     assert!(error.is_err(), "a file that is not a checkpoint is refused");
 }
