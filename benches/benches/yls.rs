@@ -31,7 +31,10 @@ fn bench_steps(c: &mut Criterion) {
             .expect("cuts")
             .0;
         let placed = place(&swatch, &scene, &settings).expect("places");
-        let name = format!("stretch-x, stock {tiles}x{tiles} tiles, {} vertices, {STEPS} steps", swatch.positions_m.len());
+        let name = format!(
+            "stretch-x, stock {tiles}x{tiles} tiles, {} vertices, {STEPS} steps",
+            swatch.positions_m.len()
+        );
         g.bench_function(name, |b| {
             b.iter_batched(
                 || Simulation::new(&placed).expect("a valid scene"),

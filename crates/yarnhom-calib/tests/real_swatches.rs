@@ -213,8 +213,11 @@ fn the_own_stitch_tiles_fit_weft_and_warp_within_ten_percent_at_once_nowhere() {
         let bounds = problem.basis.bounds();
         let mut best = (f64::INFINITY, Vec::new(), [0.0; 2]);
         for k in 1..=samples {
-            let x: Vec<f64> =
-                bounds.iter().enumerate().map(|(j, (lo, hi))| lo + halton(k, PRIMES[j]) * (hi - lo)).collect();
+            let x: Vec<f64> = bounds
+                .iter()
+                .enumerate()
+                .map(|(j, (lo, hi))| lo + halton(k, PRIMES[j]) * (hi - lo))
+                .collect();
             let Ok(evaluation) = problem.evaluate(&x, &targets) else { continue };
             let (error, each) = common_scale_comfort_error(&targets, &evaluation.curves);
             if error < best.0 {
@@ -262,7 +265,9 @@ fn common_scale_comfort_error(
         for (e, (t, c)) in each.iter_mut().zip(targets.iter().zip(curves)) {
             let comfort: Vec<f64> = (0..t.stretch.len())
                 .filter(|&i| t.stretch[i] <= t.comfort_stretch * (1.0 + 1e-9))
-                .map(|i| (a * c.stress_n_m[i] - t.stress_n_m[i]) / (1.0 + t.stretch[i]) / t.comfort_stress_n_m)
+                .map(|i| {
+                    (a * c.stress_n_m[i] - t.stress_n_m[i]) / (1.0 + t.stretch[i]) / t.comfort_stress_n_m
+                })
                 .collect();
             *e = (comfort.iter().map(|r| r * r).sum::<f64>() / comfort.len().max(1) as f64).sqrt();
         }

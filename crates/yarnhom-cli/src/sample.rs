@@ -120,7 +120,8 @@ pub fn run(args: SampleArgs) -> anyhow::Result<Outcome> {
     let (pattern, model, inputs) = open_pattern_and_model(&args.pattern, &args.model)?;
     let tile = RveModel::new(&pattern, &model).with_context(|| format!("{}", args.pattern.display()))?;
     let plan = SamplePlan::thesis(&plan_ranges(&args)?, args.n1d, args.n2d)?;
-    let shard = args.shard.as_deref().map(parse_shard).transpose().map_err(|e| anyhow::anyhow!("--shard {e}"))?;
+    let shard =
+        args.shard.as_deref().map(parse_shard).transpose().map_err(|e| anyhow::anyhow!("--shard {e}"))?;
     let shard = shard.map(|(index, count)| GridShard { index, count });
     let options = SampleOptions {
         max_iterations: args.max_iterations,

@@ -137,7 +137,11 @@ fn swatch(args: SwatchArgs) -> anyhow::Result<Outcome> {
         (None, Some(tiles)) => SwatchSize::Tiles(tiles),
         (None, None) => anyhow::bail!("give --size or --tiles"),
     };
-    let glue = GlueSettings { reach_radii: args.glue_reach, pre_stretch: args.glue_pre_stretch, stiffness_n_m: None };
+    let glue = GlueSettings {
+        reach_radii: args.glue_reach,
+        pre_stretch: args.glue_pre_stretch,
+        stiffness_n_m: None,
+    };
     let (swatch, report) = cut_swatch(&pattern, &model, size, glue)?;
     write_artifact(&args.output, &swatch, "yls swatch", inputs)?;
     eprintln!("{}", report.summary());
@@ -176,7 +180,11 @@ fn record(args: RecordArgs) -> anyhow::Result<Outcome> {
 }
 
 fn settings(args: &RunArgs) -> RunSettings {
-    RunSettings { steps_per_frame: args.steps_per_frame, damping_rate_per_s: args.damping, ..RunSettings::default() }
+    RunSettings {
+        steps_per_frame: args.steps_per_frame,
+        damping_rate_per_s: args.damping,
+        ..RunSettings::default()
+    }
 }
 
 fn metadata(args: &RunArgs, scene: &str, variation: serde_json::Value) -> TraceMetadata {
@@ -204,20 +212,21 @@ fn run_to_trace(
         bar.set_position(r.frame);
         bar.set_message(format!("closest {:.2} r", r.closest_distance_radii));
     };
-    let plan = Frames { count: frames, frame_time_s: scene.frame_time_s, steps_per_frame: args.steps_per_frame };
+    let plan =
+        Frames { count: frames, frame_time_s: scene.frame_time_s, steps_per_frame: args.steps_per_frame };
     if args.checkpoint_every == 0 || is_stdio(output) {
         let mut trace = open_trace(output, metadata)?;
         record_run(&mut trace, &mut simulation, &swatch.name, &plan, progress)?;
         finish_trace(Some(trace), Some(output))?;
     } else {
-        let path = Path::new(output);
-        let every = args.checkpoint_every;
-        let resumed = record_resumable(path, metadata, &mut simulation, &swatch.name, &plan, every, progress)?;
+        let (path, every) = (Path::new(output), args.checkpoint_every);
+        let resumed =
+            record_resumable(path, metadata, &mut simulation, &swatch.name, &plan, every, progress)?;
         if resumed > 0 {
             eprintln!("resumed {output} at frame {resumed}");
         }
     }
     bar.finish_and_clear();
-    eprintln!("simulated {} s of {} yarns, {} vertices", simulation.time_s(), swatch.yarns.len(), swatch.positions_m.len());
+    eprintln!("simulated {} s of {} yarn vertices", simulation.time_s(), swatch.positions_m.len());
     Ok(())
 }

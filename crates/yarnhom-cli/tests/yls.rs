@@ -31,7 +31,8 @@ fn fails_with(args: &[&str], cwd: &Path, problem: &str) {
 fn a_swatch_is_cut_and_a_stretch_is_simulated_on_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path();
-    let report = ok(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--tiles", "2x2", "-o", "s.swatch.yh"], d);
+    let report =
+        ok(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--tiles", "2x2", "-o", "s.swatch.yh"], d);
     assert!(report.contains("yarns") && report.contains("glue springs"), "{report}");
     let inspected = String::from_utf8_lossy(&yarnhom(&["inspect", "s.swatch.yh"], d).stdout).into_owned();
     assert!(inspected.contains("swatch"), "{inspected}");
@@ -46,8 +47,16 @@ fn a_swatch_is_cut_and_a_stretch_is_simulated_on_it() {
     assert_eq!(frames.iter().map(|f| f.frame).collect::<Vec<_>>(), vec![0, 1]);
     assert!(frames[1].positions_m.iter().all(|p| p.iter().all(|x| x.is_finite())));
 
-    fails_with(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--size", "0.001x0.3", "-o", "x.yh"], d, "tile");
-    fails_with(&["yls", "simulate", "drape", "--swatch", "s.swatch.yh", "-o", "x.mcap"], d, "holds no yarn vertex");
+    fails_with(
+        &["yls", "swatch", STOCK, "--model", "table4.1:stock", "--size", "0.001x0.3", "-o", "x.yh"],
+        d,
+        "tile",
+    );
+    fails_with(
+        &["yls", "simulate", "drape", "--swatch", "s.swatch.yh", "-o", "x.mcap"],
+        d,
+        "holds no yarn vertex",
+    );
     fails_with(&["yls", "simulate", "stretch-x", "--swatch", STOCK, "-o", "x.mcap"], d, "swatch");
 }
 
@@ -57,7 +66,8 @@ fn record_writes_one_trace_per_sequence_shard_by_shard_and_resumes() {
     let d = dir.path();
     ok(&["yls", "swatch", STOCK, "--model", "table4.1:stock", "--tiles", "2x2", "-o", "s.swatch.yh"], d);
     let record = |shard: &str| {
-        let args = ["yls", "record", "stretch-x", "--swatch", "s.swatch.yh", "--variations", "2", "--seed", "5"];
+        let args =
+            ["yls", "record", "stretch-x", "--swatch", "s.swatch.yh", "--variations", "2", "--seed", "5"];
         let mut args = args.to_vec();
         args.extend(["--frames", "2", "--shard", shard, "-o", "data"]);
         ok(&args, d)
@@ -79,9 +89,22 @@ fn record_writes_one_trace_per_sequence_shard_by_shard_and_resumes() {
     assert_ne!(variation(&first), variation(&second));
 
     // The sequences as a training set: the bars' vertices are handles.
-    ok(&["trace", "export", "--format", "training", "data/seq_000000.mcap", "data/seq_000001.mcap", "-o", "set"], d);
+    ok(
+        &[
+            "trace",
+            "export",
+            "--format",
+            "training",
+            "data/seq_000000.mcap",
+            "data/seq_000001.mcap",
+            "-o",
+            "set",
+        ],
+        d,
+    );
     let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("set/meta.json")).expect("meta.json")).expect("JSON");
+        serde_json::from_str(&std::fs::read_to_string(d.join("set/meta.json")).expect("meta.json"))
+            .expect("JSON");
     assert_eq!(meta["trajectory_length"], 3, "{meta}");
     assert_eq!(meta["sequences"].as_array().map(Vec::len), Some(2), "{meta}");
 }

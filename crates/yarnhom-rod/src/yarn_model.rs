@@ -26,4 +26,3 @@ pub fn rod_laws(model: &YarnModel) -> (RodMaterial, ContactLaw) {
         ),
     }
 }
-

@@ -29,7 +29,8 @@ pub fn yarn_nodes(simulation: &Simulation, name: &str) -> YarnNodes {
             let vertices = simulation.yarn_vertices(yarn);
             let n = vertices.len();
             let first = vertices.start;
-            (0..simulation.yarn_edge_count(yarn)).map(move |e| [(first + e) as u32, (first + (e + 1) % n) as u32])
+            (0..simulation.yarn_edge_count(yarn))
+                .map(move |e| [(first + e) as u32, (first + (e + 1) % n) as u32])
         })
         .collect();
     YarnNodes { yarns: name.into(), rest_positions_m: simulation.positions_m(), node_type, edges }
@@ -213,7 +214,10 @@ fn read_saved(path: &Path, run_id: &str) -> Result<Option<Saved>, RecordError> {
     };
     let saved: Saved = rmp_serde::from_slice(&bytes).map_err(|e| checkpoint_error(path, e))?;
     if saved.run != run_id {
-        return Err(checkpoint_error(path, "the checkpoint of another run (other scene, swatch or settings): delete it to start over"));
+        return Err(checkpoint_error(
+            path,
+            "the checkpoint of another run (other scene, swatch or settings): delete it to start over",
+        ));
     }
     Ok(Some(saved))
 }

@@ -10,9 +10,9 @@
 //!   A handle that holds no vertex is an error;
 //! - **obstacles**: spheres and planes, as barriers on the gap between a yarn's surface and the
 //!   obstacle ([`RunSettings::obstacle_activation_radii`], [`RunSettings::obstacle_stiffness_n_m`]);
-//!   boxes are refused (not yet modelled), as is friction, which the yarn-level run ignores
-//!   (stated in the run's metadata by the caller);
-//! - **gravity**: the scene's;
+//!   boxes are refused (not yet modelled); friction is not modelled at yarn level;
+//! - **gravity**: the scene's; **air drag**: the scene's wind on the yarn segments, the
+//!   swatch's area shared among them by rest length ([`YarnWind`]);
 //! - **damping**: the scene's Rayleigh terms are the shell's; the yarns get Kaldor et al.
 //!   (2008)'s damping of non-rigid motion at [`RunSettings::damping_rate_per_s`], as the
 //!   thesis' yarn-level runs (Sec. 4.3.1);
@@ -27,7 +27,7 @@ use yarnhom_shell::scene::HandleSpec;
 
 use crate::dynamics::{
     Damping, Energies, Handle, InputError, Keyframe, Obstacle, ObstacleShape, Scene, Simulation, StepError,
-    StepReport,
+    StepReport, YarnWind,
 };
 use crate::scene::scene_of_swatch;
 
@@ -72,7 +72,9 @@ pub enum RunError {
         what: &'static str,
     },
     /// A handle holds no yarn vertex.
-    #[error("scene '{scene}': handle {handle} holds no yarn vertex of the swatch (the swatch is centred on the origin)")]
+    #[error(
+        "scene '{scene}': handle {handle} holds no yarn vertex of the swatch (the swatch is centred on the origin)"
+    )]
     NothingHeld {
         /// The scene.
         scene: String,
@@ -100,7 +102,11 @@ pub enum RunError {
 
 /// The dynamics scene of `swatch` placed in `scene`'s cloth rectangle, with its handles,
 /// obstacles, gravity and damping (module docs).
-pub fn place(swatch: &Swatch, scene: &yarnhom_shell::Scene, settings: &RunSettings) -> Result<Scene, RunError> {
+pub fn place(
+    swatch: &Swatch,
+    scene: &yarnhom_shell::Scene,
+    settings: &RunSettings,
+) -> Result<Scene, RunError> {
     scene.validate()?;
     check_settings(settings)?;
     let mut dynamics = scene_of_swatch(swatch);
@@ -120,6 +126,7 @@ pub fn place(swatch: &Swatch, scene: &yarnhom_shell::Scene, settings: &RunSettin
         .map(|o| obstacle(o, radius, settings, &scene.name))
         .collect::<Result<_, _>>()?;
     dynamics.gravity_m_s2 = scene.gravity;
+    dynamics.wind = (!scene.wind.is_none()).then(|| wind(swatch, &scene.wind));
     dynamics.damping = Some(Damping::kaldor(settings.damping_rate_per_s));
     Ok(dynamics)
 }
@@ -142,7 +149,21 @@ fn handles(
             }
         }
     }
-    Ok(held.into_iter().map(|h| Handle { vertices: h.vertices, keyframes: keyframes(&h.motion.keys) }).collect())
+    Ok(held
+        .into_iter()
+        .map(|h| Handle { vertices: h.vertices, keyframes: keyframes(&h.motion.keys) })
+        .collect())
+}
+
+/// The scene's air drag on the swatch's yarns: the swatch's area shared by rest length.
+fn wind(swatch: &Swatch, wind: &yarnhom_shell::wind::Wind) -> YarnWind {
+    let length_m: f64 = swatch.rest_length_m.iter().sum();
+    YarnWind {
+        density_kg_m3: wind.density_kg_m3,
+        velocity_m_s: wind.velocity_m_s,
+        drag_kg_m2_s: wind.drag_kg_m2_s,
+        area_per_length_m: swatch.size_m[0] * swatch.size_m[1] / length_m,
+    }
 }
 
 /// The translation that centres the swatch's rectangle on the origin and its yarns' mean
@@ -162,9 +183,16 @@ fn keyframes(keys: &[(f64, [f64; 3])]) -> Vec<Keyframe> {
 }
 
 /// A scene obstacle as a yarn-level barrier.
-fn obstacle(o: &ShellObstacle, radius_m: f64, settings: &RunSettings, scene: &str) -> Result<Obstacle, RunError> {
+fn obstacle(
+    o: &ShellObstacle,
+    radius_m: f64,
+    settings: &RunSettings,
+    scene: &str,
+) -> Result<Obstacle, RunError> {
     let shape = match *o {
-        ShellObstacle::Sphere { center, radius } => ObstacleShape::Sphere { centre_m: center, radius_m: radius },
+        ShellObstacle::Sphere { center, radius } => {
+            ObstacleShape::Sphere { centre_m: center, radius_m: radius }
+        }
         ShellObstacle::Plane { point, normal } => ObstacleShape::Plane { point_m: point, normal },
         ShellObstacle::Box { .. } => {
             return Err(RunError::Unsupported { scene: scene.into(), what: "box obstacles" });
@@ -179,7 +207,11 @@ fn obstacle(o: &ShellObstacle, radius_m: f64, settings: &RunSettings, scene: &st
 
 fn check_settings(settings: &RunSettings) -> Result<(), RunError> {
     let positive = |name: &str, v: f64| {
-        if v.is_finite() && v > 0.0 { Ok(()) } else { Err(RunError::Settings(format!("{name} must be positive, not {v}"))) }
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(RunError::Settings(format!("{name} must be positive, not {v}")))
+        }
     };
     if settings.steps_per_frame == 0 {
         return Err(RunError::Settings("steps per frame must be at least 1".into()));
@@ -187,7 +219,10 @@ fn check_settings(settings: &RunSettings) -> Result<(), RunError> {
     positive("the obstacle activation distance", settings.obstacle_activation_radii)?;
     positive("the obstacle stiffness", settings.obstacle_stiffness_n_m)?;
     if !(settings.damping_rate_per_s.is_finite() && settings.damping_rate_per_s >= 0.0) {
-        return Err(RunError::Settings(format!("the damping rate must be >= 0, not {}", settings.damping_rate_per_s)));
+        return Err(RunError::Settings(format!(
+            "the damping rate must be >= 0, not {}",
+            settings.damping_rate_per_s
+        )));
     }
     Ok(())
 }

@@ -32,7 +32,9 @@ pub fn scene_of_swatch(swatch: &Swatch) -> Scene {
                 rest_twist_rad: swatch.rest_twist_rad[vertices.clone()].to_vec(),
                 reference_twist_rad: swatch.reference_twist_rad[vertices].to_vec(),
                 material,
-                linear_density_kg_m: swatch.model.density_kg_m3 * std::f64::consts::PI * yarn.radius_m.powi(2),
+                linear_density_kg_m: swatch.model.density_kg_m3
+                    * std::f64::consts::PI
+                    * yarn.radius_m.powi(2),
             }
         })
         .collect();

@@ -39,7 +39,9 @@ impl Variation {
     pub fn draw(sequence: u64, variations: u64, seed: u64, size_m: [f64; 2]) -> Variation {
         let (scene, variation) = ((sequence / variations) as usize, sequence % variations);
         let mut random = SplitMix64::new(seed ^ sequence.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        let mut uniform = |lo: f64, hi: f64| if variation == 0 { (lo + hi) / 2.0 } else { lo + (hi - lo) * random.next_unit() };
+        let mut uniform = |lo: f64, hi: f64| {
+            if variation == 0 { (lo + hi) / 2.0 } else { lo + (hi - lo) * random.next_unit() }
+        };
         let motion_scale = uniform(0.5, 1.5);
         let obstacle_shift_m = [uniform(-0.1, 0.1) * size_m[0], uniform(-0.1, 0.1) * size_m[1]];
         let lift_m = if variation == 0 { 0.0 } else { uniform(0.0, 0.1) * size_m[0].min(size_m[1]) };
@@ -48,7 +50,9 @@ impl Variation {
 
     /// The shell scene with this variant's motions and obstacles.
     pub fn apply_to_scene(&self, scene: &yarnhom_shell::Scene) -> yarnhom_shell::Scene {
-        let scale = |keys: &Vec<(f64, [f64; 3])>| keys.iter().map(|&(t, d)| (t, d.map(|x| x * self.motion_scale))).collect();
+        let scale = |keys: &Vec<(f64, [f64; 3])>| {
+            keys.iter().map(|&(t, d)| (t, d.map(|x| x * self.motion_scale))).collect()
+        };
         let shift = |o: &Obstacle| match *o {
             Obstacle::Sphere { center, radius } => {
                 let [dx, dy] = self.obstacle_shift_m;
@@ -114,7 +118,11 @@ mod tests {
             assert!(v.obstacle_shift_m[0].abs() <= 0.01 && v.obstacle_shift_m[1].abs() <= 0.005);
             assert!((0.0..=0.005).contains(&v.lift_m));
             if v.variation == 0 {
-                assert_eq!((v.motion_scale, v.obstacle_shift_m, v.lift_m), (1.0, [0.0, 0.0], 0.0), "as written");
+                assert_eq!(
+                    (v.motion_scale, v.obstacle_shift_m, v.lift_m),
+                    (1.0, [0.0, 0.0], 0.0),
+                    "as written"
+                );
             }
         }
     }
@@ -129,7 +137,11 @@ mod tests {
     #[test]
     fn a_variant_scales_the_motions_and_shifts_the_spheres() {
         let scene = yarnhom_shell::Scene::builtin("drape").expect("a built-in");
-        let v = Variation { motion_scale: 2.0, obstacle_shift_m: [0.01, -0.02], ..Variation::draw(1, 2, 0, [0.1, 0.1]) };
+        let v = Variation {
+            motion_scale: 2.0,
+            obstacle_shift_m: [0.01, -0.02],
+            ..Variation::draw(1, 2, 0, [0.1, 0.1])
+        };
         let varied = v.apply_to_scene(&scene);
         let Obstacle::Sphere { center, .. } = varied.obstacles[0] else { panic!("the drape's sphere") };
         assert_eq!(center, [0.01, -0.02, -0.04]);

@@ -436,3 +436,50 @@ fn bad_input_gives_clear_errors() {
     assert_eq!(simulation.positions_m(), before, "the state is unchanged");
     assert_eq!(simulation.time_s(), 0.0);
 }
+
+/// A straight horizontal yarn falling across the air reaches the terminal speed of the wind
+/// law, `ρ s v² = λ g` (`s` the cloth area per yarn length, `λ` the linear density), and air
+/// moving along the yarn drags it along at the drag coefficient's rate.
+#[test]
+fn a_falling_yarn_reaches_the_terminal_speed_of_the_wind_law() {
+    use yarnhom_yls::dynamics::YarnWind;
+    let (density, area_per_length, lambda) = (7.5, 2e-3, 3.77e-4);
+    let yarn = straight(20, [0.0; 3], [0.005, 0.0, 0.0], 1e-3, material(1e-9, 1e-9, 10.0), lambda);
+    let wind = YarnWind {
+        density_kg_m3: density,
+        velocity_m_s: [0.0; 3],
+        drag_kg_m2_s: 0.0,
+        area_per_length_m: area_per_length,
+    };
+    let scene = Scene { gravity_m_s2: [0.0, 0.0, -9.81], wind: Some(wind), ..Scene::new(vec![yarn.clone()]) };
+    let mut simulation = Simulation::new(&scene).expect("a valid scene");
+    for _ in 0..600 {
+        simulation.step(1e-3).expect("steps");
+    }
+    let terminal = (lambda * 9.81 / (density * area_per_length)).sqrt();
+    for v in simulation.velocities_m_s() {
+        assert!((v[2] + terminal).abs() < 1e-3 * terminal, "{} m/s against -{terminal} m/s", v[2]);
+        assert!(v[0].abs() < 1e-9 && v[1].abs() < 1e-9);
+    }
+
+    // Air along the yarn at 1 m/s drags it with `d s (u - v)` per length: `v = u (1 - e^(-d s t / λ))`.
+    let drag = 0.05;
+    let along = YarnWind {
+        density_kg_m3: density,
+        velocity_m_s: [1.0, 0.0, 0.0],
+        drag_kg_m2_s: drag,
+        area_per_length_m: area_per_length,
+    };
+    let scene = Scene { wind: Some(along), ..Scene::new(vec![yarn]) };
+    let mut simulation = Simulation::new(&scene).expect("a valid scene");
+    let (h, steps) = (1e-4, 500);
+    for _ in 0..steps {
+        simulation.step(h).expect("steps");
+    }
+    let rate = drag * area_per_length / lambda;
+    // The force is taken at each step's start (explicit, as ARCSim's): `v_{k+1} = v_k +
+    // h r (u - v_k)`, so `v_k = u (1 - (1 - h r)^k)` exactly.
+    let expected = 1.0 - (1.0 - h * rate).powi(steps);
+    let v = simulation.velocities_m_s()[10][0];
+    assert!((v - expected).abs() < 1e-6, "{v} m/s against {expected} m/s");
+}

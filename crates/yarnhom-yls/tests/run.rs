@@ -47,7 +47,8 @@ fn stretch_bars_grip_the_yarns_near_their_sides_and_pull_them_apart() {
     };
     let start = width_at(&simulation);
     let mut closest = f64::INFINITY;
-    let plan = Frames { count: 2, frame_time_s: scene.frame_time_s, steps_per_frame: settings.steps_per_frame };
+    let plan =
+        Frames { count: 2, frame_time_s: scene.frame_time_s, steps_per_frame: settings.steps_per_frame };
     run(&mut simulation, 0..=2, &plan, |report, _| {
         closest = closest.min(report.closest_distance_radii);
         Ok(())
@@ -64,12 +65,17 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     let swatch = stock_swatch([2, 2]);
     let scene = yarnhom_shell::Scene::builtin("drape").expect("a built-in");
     // The drape's handle spheres sit 10 cm off the centre: on a 3 cm swatch they grip nothing.
-    let error = place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("no yarn in the spheres");
+    let error =
+        place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("no yarn in the spheres");
     assert!(matches!(error, RunError::NothingHeld { handle: 0, .. }), "{error}");
 
     let scene = yarnhom_shell::Scene { handles: vec![], ..scene };
     let placed = place(&swatch, &scene, &RunSettings::default()).expect("places");
     assert_eq!(placed.obstacles.len(), 1, "the drape's sphere");
+    let wind = placed.wind.expect("the published drape's air drag");
+    assert_eq!(wind.density_kg_m3, scene.wind.density_kg_m3);
+    let length: f64 = swatch.rest_length_m.iter().sum();
+    assert!((wind.area_per_length_m * length - swatch.size_m[0] * swatch.size_m[1]).abs() < 1e-15);
     let mut simulation = Simulation::new(&placed).expect("a valid scene");
     let dir = tempfile::tempdir().expect("tempdir");
     let path = dir.path().join("run.mcap");
@@ -114,7 +120,10 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
 fn box_obstacles_and_bad_settings_are_refused() {
     let swatch = stock_swatch([2, 2]);
     let scene = yarnhom_shell::Scene {
-        obstacles: vec![yarnhom_shell::contact::Obstacle::Box { min: [-1.0, -1.0, -2.0], max: [1.0, 1.0, -1.0] }],
+        obstacles: vec![yarnhom_shell::contact::Obstacle::Box {
+            min: [-1.0, -1.0, -2.0],
+            max: [1.0, 1.0, -1.0],
+        }],
         ..yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in")
     };
     let error = place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("a box");
@@ -163,7 +172,10 @@ fn a_killed_recording_resumes_from_its_checkpoint_to_the_same_bits() {
     assert!(!resumed.exists());
     assert!(dir.path().join("resumed.mcap.checkpoint").exists(), "frames 0 and 1 were checkpointed");
     assert_eq!(record(&resumed, 1, None).expect("resumes"), 2, "from frame 2");
-    assert!(!dir.path().join("resumed.mcap.checkpoint").exists() && !dir.path().join("resumed.mcap.part0000").exists());
+    assert!(
+        !dir.path().join("resumed.mcap.checkpoint").exists()
+            && !dir.path().join("resumed.mcap.part0000").exists()
+    );
 
     let (a, b) = (yarn_frames(&straight), yarn_frames(&resumed));
     assert_eq!(a.len(), 4);
@@ -171,9 +183,13 @@ fn a_killed_recording_resumes_from_its_checkpoint_to_the_same_bits() {
 
     let other = TraceMetadata::new("test", "0").with_entry("scene", "drape");
     let mut simulation = Simulation::new(&placed).expect("a valid scene");
-    std::fs::write(dir.path().join("x.mcap.checkpoint"), std::fs::read(dir.path().join("straight.mcap")).expect("bytes"))
-        .expect("writes");
+    std::fs::write(
+        dir.path().join("x.mcap.checkpoint"),
+        std::fs::read(dir.path().join("straight.mcap")).expect("bytes"),
+    )
+    .expect("writes");
     let plan = Frames { count: 1, frame_time_s: 0.01, steps_per_frame: 1 };
-    let error = record_resumable(&dir.path().join("x.mcap"), &other, &mut simulation, "stock", &plan, 1, |_| {});
+    let error =
+        record_resumable(&dir.path().join("x.mcap"), &other, &mut simulation, "stock", &plan, 1, |_| {});
     assert!(error.is_err(), "a file that is not a checkpoint is refused");
 }

@@ -531,7 +531,8 @@ fn a_swatch_of_a_published_rest_state_stays_put_in_its_interior() {
     use yarnhom_yls::dynamics::{Damping, Simulation};
     use yarnhom_yls::scene::scene_of_swatch;
     let (_, swatch, _) = cut("stock", SwatchSize::Tiles([5, 5]));
-    let scene = yarnhom_yls::dynamics::Scene { damping: Some(Damping::kaldor(100.0)), ..scene_of_swatch(&swatch) };
+    let scene =
+        yarnhom_yls::dynamics::Scene { damping: Some(Damping::kaldor(100.0)), ..scene_of_swatch(&swatch) };
     let mut simulation = Simulation::new(&scene).expect("a valid scene");
     let start = simulation.positions_m();
     let mut closest = f64::INFINITY;
@@ -551,7 +552,11 @@ fn a_swatch_of_a_published_rest_state_stays_put_in_its_interior() {
     };
     let (inside, border) = (moved(&interior), moved(&|p| !interior(p)));
     let r = swatch.yarns[0].radius_m;
-    eprintln!("2 steps of 0.1 ms: interior moved {:.3} r, border {:.3} r; closest {closest:.3} r", inside / r, border / r);
+    eprintln!(
+        "2 steps of 0.1 ms: interior moved {:.3} r, border {:.3} r; closest {closest:.3} r",
+        inside / r,
+        border / r
+    );
     assert!(inside < 0.1 * border, "interior {inside} m, border {border} m");
     assert!(closest > 0.5, "closest centrelines {closest} radii");
 }

@@ -38,7 +38,12 @@ impl Simulation {
             time_s: self.state.time_s,
             dofs: self.state.q.as_slice().to_vec(),
             velocities_m_s: self.state.velocity.as_slice().to_vec(),
-            references: self.system.rods.iter().map(|rod| rod.references().iter().map(frame).collect()).collect(),
+            references: self
+                .system
+                .rods
+                .iter()
+                .map(|rod| rod.references().iter().map(frame).collect())
+                .collect(),
             pattern: self.solver.analysed_pattern(),
         }
     }
@@ -54,14 +59,20 @@ impl Simulation {
         length("checkpoint yarns", checkpoint.references.len(), self.system.rods.len())?;
         let finite = checkpoint.dofs.iter().chain(&checkpoint.velocities_m_s).all(|x| x.is_finite());
         if !(finite && checkpoint.time_s.is_finite()) {
-            return Err(InputError::Parameter { what: "checkpoint state".into(), range: "finite", value: f64::NAN });
+            return Err(InputError::Parameter {
+                what: "checkpoint state".into(),
+                range: "finite",
+                value: f64::NAN,
+            });
         }
         let solver = match &checkpoint.pattern {
-            Some((n, entries)) => SpdSolver::with_pattern(*n, entries).map_err(|_| InputError::Parameter {
-                what: "checkpoint sparsity pattern".into(),
-                range: "within the matrix, lower triangle",
-                value: *n as f64,
-            })?,
+            Some((n, entries)) => {
+                SpdSolver::with_pattern(*n, entries).map_err(|_| InputError::Parameter {
+                    what: "checkpoint sparsity pattern".into(),
+                    range: "within the matrix, lower triangle",
+                    value: *n as f64,
+                })?
+            }
             None => SpdSolver::default(),
         };
         let frame = |&([t0, d0, t1, d1], twist): &([[f64; 3]; 4], f64)| BendTwistReference {
@@ -70,8 +81,11 @@ impl Simulation {
         };
         for (rod, saved) in self.system.rods.iter_mut().zip(&checkpoint.references) {
             let references: Vec<BendTwistReference> = saved.iter().map(frame).collect();
-            rod.set_references(&references)
-                .map_err(|expected| InputError::Length { what: "checkpoint references", got: saved.len(), expected })?;
+            rod.set_references(&references).map_err(|expected| InputError::Length {
+                what: "checkpoint references",
+                got: saved.len(),
+                expected,
+            })?;
         }
         self.state = State {
             q: DVector::from_vec(checkpoint.dofs.clone()),

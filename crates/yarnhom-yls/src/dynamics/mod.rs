@@ -27,6 +27,7 @@
 //! - **Handles** ([`Handle`]): keyframed rigid translations, piecewise linear; held vertices are
 //!   Dirichlet conditions, eliminated from the solve. They move to their new positions at a
 //!   step's start, under the same caps: a move the caps would cut is an error.
+//! - **Wind** ([`YarnWind`]): ARCSim's air drag carried to yarn segments, explicit over a step.
 //! - **Damping** ([`Damping`]): Kaldor et al. (2008)'s damping of non-rigid motion over
 //!   overlapping windows of 5 consecutive vertices (stride 1), projections fixed per step.
 //! - **Convergence**: the Newton step moves no vertex more than `10⁻⁶ r` and no twist more than
@@ -47,16 +48,18 @@ mod simulation;
 mod springs;
 mod step;
 mod system;
+mod wind;
 
 pub use checkpoint::Checkpoint;
 pub use damping::Damping;
 pub use handles::{Handle, Keyframe};
 pub use input::{InputError, YarnInput};
-pub use yarnhom_artifacts::GlueSpring;
 pub use obstacles::{Obstacle, ObstacleShape};
 pub use simulation::Simulation;
 pub use step::{Energies, StepError, StepReport};
 pub use system::{ContactModel, Scene, SolverOptions};
+pub use wind::YarnWind;
+pub use yarnhom_artifacts::GlueSpring;
 pub use yarnhom_rod::{ContactLaw, RodMaterial, StretchLaw};
 
 #[cfg(test)]

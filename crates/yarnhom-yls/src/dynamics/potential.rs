@@ -21,6 +21,7 @@ use super::contact::Candidate;
 use super::damping::DampingTerm;
 use super::springs::glue_energy;
 use super::system::System;
+use super::wind::wind_forces;
 
 /// The parts of the incremental potential (J).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -37,6 +38,8 @@ pub(crate) struct PotentialParts {
     pub obstacle: f64,
     /// Gravity, from the step's start.
     pub gravity: f64,
+    /// Work of the wind's force (held over the step), from the step's start.
+    pub wind: f64,
     /// Dissipation potential `D`.
     pub damping: f64,
     /// The twist gauge term.
@@ -52,6 +55,7 @@ impl PotentialParts {
             + self.contact
             + self.obstacle
             + self.gravity
+            + self.wind
             + self.damping
             + self.twist_anchor
     }
@@ -65,6 +69,7 @@ impl PotentialParts {
             self.contact,
             self.obstacle,
             self.gravity,
+            self.wind,
             self.damping,
             self.twist_anchor,
         ]
@@ -114,6 +119,8 @@ pub(crate) struct StepContext<'a> {
     /// `h` (s).
     pub time_step_s: f64,
     pub damping: Option<DampingTerm>,
+    /// The wind's force on every vertex over the step (empty without wind).
+    pub wind_forces: Vec<Vector3<f64>>,
 }
 
 impl<'a> StepContext<'a> {
@@ -130,14 +137,15 @@ impl<'a> StepContext<'a> {
             .damping
             .as_ref()
             .map(|(d, windows)| DampingTerm::new(windows, &system.masses_kg, q_n, d.rate_per_s, time_step_s));
-        StepContext { system, q_n, predicted, time_step_s, damping }
+        let wind_forces = system.wind.map(|w| wind_forces(system, &w, q_n, v_n)).unwrap_or_default();
+        StepContext { system, q_n, predicted, time_step_s, damping, wind_forces }
     }
 
     /// The potential of a state `q` at rest, without damping: its parts other than inertia and
     /// gravity (both zero there) are the state's energies.
     pub(crate) fn at_rest(system: &'a System, q: &'a DVector<f64>) -> Self {
         let predicted = q.rows(0, 3 * system.vertex_count()).into_owned();
-        StepContext { system, q_n: q, predicted, time_step_s: 1.0, damping: None }
+        StepContext { system, q_n: q, predicted, time_step_s: 1.0, damping: None, wind_forces: vec![] }
     }
 
     /// `Φ(q)`, with the contact of the pairs `candidates`.
@@ -155,17 +163,20 @@ impl<'a> StepContext<'a> {
         out
     }
 
-    /// `1/(2h²) |x - x̃|²_M` and `-Σ m g · (x - x_n)`.
+    /// `1/(2h²) |x - x̃|²_M`, `-Σ m g · (x - x_n)` and the wind's `-Σ f · (x - x_n)`.
     fn add_inertia_and_gravity(&self, q: &DVector<f64>, want: Want, out: &mut Evaluation) {
         let h2 = self.time_step_s * self.time_step_s;
         let g = self.system.gravity;
         for (v, &m) in self.system.masses_kg.iter().enumerate() {
             let x = System::position(q, v);
             let offset = x - self.predicted.fixed_rows::<3>(3 * v);
+            let moved = x - System::position(self.q_n, v);
+            let wind = self.wind_forces.get(v).copied().unwrap_or_else(Vector3::zeros);
             out.parts.inertia += 0.5 * m / h2 * offset.norm_squared();
-            out.parts.gravity -= m * g.dot(&(x - System::position(self.q_n, v)));
+            out.parts.gravity -= m * g.dot(&moved);
+            out.parts.wind -= wind.dot(&moved);
             if want == Want::Derivatives {
-                let gradient = offset * (m / h2) - g * m;
+                let gradient = offset * (m / h2) - g * m - wind;
                 out.add(&[3 * v, 3 * v + 1, 3 * v + 2], gradient.as_slice(), |a, b| {
                     if a == b { m / h2 } else { 0.0 }
                 });

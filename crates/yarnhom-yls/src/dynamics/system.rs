@@ -12,6 +12,7 @@ use yarnhom_artifacts::GlueSpring;
 
 use super::input::{InputError, YarnInput, non_negative, positive};
 use super::obstacles::Obstacle;
+use super::wind::YarnWind;
 
 /// How yarns repel each other.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -75,6 +76,8 @@ pub struct Scene {
     pub handles: Vec<Handle>,
     /// Damping of non-rigid motion, if any.
     pub damping: Option<Damping>,
+    /// Air drag, if any.
+    pub wind: Option<YarnWind>,
     /// Newton solver settings.
     pub solver: SolverOptions,
 }
@@ -90,6 +93,7 @@ impl Scene {
             obstacles: vec![],
             handles: vec![],
             damping: None,
+            wind: None,
             solver: SolverOptions::default(),
         }
     }
@@ -107,6 +111,10 @@ pub(crate) struct System {
     pub vertex_offsets: Vec<usize>,
     /// First global edge of every yarn, and the number of edges at the end.
     pub edge_offsets: Vec<usize>,
+    /// Every segment: its two global vertices and its rest length (m).
+    pub segments: Vec<(usize, usize, f64)>,
+    /// Air drag, if any.
+    pub wind: Option<YarnWind>,
     /// Lumped mass of every vertex (kg): linear density times half the adjacent rest lengths.
     pub masses_kg: Vec<f64>,
     /// Radius of every vertex's yarn (m).
@@ -153,10 +161,12 @@ impl System {
         let mut masses_kg = vec![0.0; vertices];
         let mut vertex_radius_m = vec![0.0; vertices];
         let mut twist_scale_nm = vec![];
+        let mut segments = vec![];
         for (y, yarn) in scene.yarns.iter().enumerate() {
             let first = vertex_offsets[y];
             let n = yarn.vertex_count();
             for (e, &rest) in yarn.rest_length_m.iter().enumerate() {
+                segments.push((first + e, first + (e + 1) % n, rest));
                 for v in [e, (e + 1) % n] {
                     masses_kg[first + v] += 0.5 * rest * yarn.linear_density_kg_m;
                 }
@@ -173,6 +183,9 @@ impl System {
         let held = held_vertices(scene, vertices)?;
         let contact = contact_law(scene.contact, radius_m)?;
         validate_options(&scene.solver)?;
+        if let Some(w) = &scene.wind {
+            validate_wind(w)?;
+        }
         if !scene.gravity_m_s2.iter().all(|g| g.is_finite()) {
             return Err(InputError::Parameter { what: "gravity".into(), range: "finite", value: f64::NAN });
         }
@@ -214,11 +227,14 @@ impl System {
                 (vertex_offsets[y], yarn.vertex_count(), yarn.closed, yarn.rest_length_m.as_slice())
             })
             .collect();
-        let glued: Vec<(usize, usize)> = scene.glue.iter().map(|g| (g.vertices[0] as usize, g.vertices[1] as usize)).collect();
+        let glued: Vec<(usize, usize)> =
+            scene.glue.iter().map(|g| (g.vertices[0] as usize, g.vertices[1] as usize)).collect();
         Ok(System {
             rods: scene.yarns.iter().map(YarnInput::rod).collect(),
             vertex_offsets,
             edge_offsets,
+            segments,
+            wind: scene.wind,
             masses_kg,
             vertex_radius_m,
             radius_m,
@@ -290,6 +306,16 @@ impl System {
             rod.update_references(q);
         }
     }
+}
+
+/// Wind: finite velocity, non-negative coefficients and area.
+fn validate_wind(w: &YarnWind) -> Result<(), InputError> {
+    if !w.velocity_m_s.iter().all(|u| u.is_finite()) {
+        return Err(InputError::Parameter { what: "wind velocity".into(), range: "finite", value: f64::NAN });
+    }
+    non_negative("wind density", w.density_kg_m3)?;
+    non_negative("wind drag", w.drag_kg_m2_s)?;
+    non_negative("wind area per yarn length", w.area_per_length_m)
 }
 
 /// Glue springs: vertices in range, stiffness and rest length finite and non-negative.
