@@ -130,16 +130,8 @@ fn hdf5_export_is_read_by_h5py_through_its_manifest() {
     assert!(summary.contains("1 file written") && summary.contains("/solver"), "{summary}");
     assert_eq!(sorted_file_names(dir.path()), ["t.h5", "t.mcap"], "no temporary file is left");
 
-    let probe = Command::new("python3").args(["-c", "import h5py, numpy"]).output();
-    match probe {
-        Ok(probe) if probe.status.success() => {}
-        Ok(probe) => {
-            return println!(
-                "SKIPPED: h5py is not installed: {}",
-                String::from_utf8_lossy(&probe.stderr).trim()
-            );
-        }
-        Err(err) => return println!("SKIPPED: python3 cannot be run: {err}"),
+    if !python_with_h5py() {
+        return;
     }
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/read_training_h5.py");
     let read = Command::new("python3")
@@ -232,16 +224,8 @@ fn yarn_traces_become_a_training_set_whose_targets_are_the_simulated_acceleratio
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("only `training` takes several"));
 
-    let probe = Command::new("python3").args(["-c", "import h5py, numpy"]).output();
-    match probe {
-        Ok(probe) if probe.status.success() => {}
-        Ok(probe) => {
-            return println!(
-                "SKIPPED: h5py is not installed: {}",
-                String::from_utf8_lossy(&probe.stderr).trim()
-            );
-        }
-        Err(err) => return println!("SKIPPED: python3 cannot be run: {err}"),
+    if !python_with_h5py() {
+        return;
     }
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../tools/training_example.py");
     let run = |extra: &[&str]| {
@@ -286,4 +270,19 @@ fn yarn_traces_become_a_training_set_whose_targets_are_the_simulated_acceleratio
     check(&sequences[1], "0", 12, slower);
     assert_eq!(sequences[1]["source"], "b.mcap");
     assert!((seen["dt"].as_f64().expect("dt") - DT).abs() < 1e-15);
+}
+
+/// Whether `python3` with h5py and numpy can run here (else the caller skips, saying why).
+fn python_with_h5py() -> bool {
+    match Command::new("python3").args(["-c", "import h5py, numpy"]).output() {
+        Ok(probe) if probe.status.success() => true,
+        Ok(probe) => {
+            println!("SKIPPED: h5py is not installed: {}", String::from_utf8_lossy(&probe.stderr).trim());
+            false
+        }
+        Err(err) => {
+            println!("SKIPPED: python3 cannot be run: {err}");
+            false
+        }
+    }
 }

@@ -192,7 +192,8 @@ fn parse_obj(path: &Path) -> Obj {
     obj
 }
 
-fn file_names(dir: &Path) -> Vec<String> {
+/// The names of the files in `dir`, sorted.
+pub(crate) fn file_names(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = std::fs::read_dir(dir)
         .expect("read dir")
         .map(|entry| entry.expect("entry").file_name().to_string_lossy().into_owned())

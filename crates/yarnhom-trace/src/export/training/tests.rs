@@ -6,6 +6,7 @@ use std::path::Path;
 use ::hdf5::types::{FloatSize, IntSize, TypeDescriptor};
 
 use super::*;
+use crate::export::tests::file_names;
 use crate::export::{ExportFormat, export_paths};
 use crate::{MeshFrame, MeshTopology, Scalars, TraceMetadata, TraceWriter, TraceWriterOptions};
 
@@ -89,15 +90,6 @@ fn dtype(file: &File, path: &str) -> TypeDescriptor {
 fn meta(dir: &Path) -> TrainingMeta {
     let text = std::fs::read_to_string(dir.join(META_FILE)).expect("meta.json");
     serde_json::from_str(&text).expect("meta json")
-}
-
-fn file_names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .expect("read dir")
-        .map(|entry| entry.expect("entry").file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 #[test]
