@@ -49,15 +49,43 @@ impl Analysis {
     }
 
     /// The value slot of every triplet (`None` above the diagonal, which is not read) into
-    /// `slots`; whether all lower-triangle triplets are in the pattern.
+    /// `slots`; whether all lower-triangle triplets are in the pattern. The triplets are
+    /// bucketed by column, and each column's rows are looked up in a row-indexed table of its
+    /// slots (a pass over the triplets and the pattern, where a search per triplet costs far more).
     fn map_slots(&self, triplets: &[(usize, usize, f64)], slots: &mut Vec<Option<usize>>) -> bool {
+        let n = self.size();
         slots.clear();
-        let mut covered = true;
-        slots.extend(triplets.iter().map(|&(i, j, _)| {
-            let slot = if i >= j { self.slot(i, j) } else { None };
-            covered &= i < j || slot.is_some();
-            slot
-        }));
+        slots.resize(triplets.len(), None);
+        let lower = |&(i, j, _): &(usize, usize, f64)| i >= j && i < n;
+        let mut starts = vec![0; n + 1];
+        for t in triplets.iter().filter(|t| lower(t)) {
+            starts[t.1 + 1] += 1;
+        }
+        for col in 0..n {
+            starts[col + 1] += starts[col];
+        }
+        let mut next = starts.clone();
+        let mut bucketed = vec![0; starts[n]];
+        for (k, t) in triplets.iter().enumerate().filter(|(_, t)| lower(t)) {
+            bucketed[next[t.1]] = k;
+            next[t.1] += 1;
+        }
+        let mut slot_of_row = vec![usize::MAX; n];
+        let mut covered = triplets.iter().all(|t| t.0 < n && t.1 < n);
+        for col in 0..n {
+            let range = self.structure.col_range(col);
+            for (slot, &row) in range.clone().zip(&self.structure.row_idx()[range.clone()]) {
+                slot_of_row[row] = slot;
+            }
+            for &k in &bucketed[starts[col]..starts[col + 1]] {
+                let slot = slot_of_row[triplets[k].0];
+                covered &= slot != usize::MAX;
+                slots[k] = (slot != usize::MAX).then_some(slot);
+            }
+            for &row in &self.structure.row_idx()[range] {
+                slot_of_row[row] = usize::MAX;
+            }
+        }
         covered
     }
 }

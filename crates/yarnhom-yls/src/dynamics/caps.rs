@@ -6,15 +6,16 @@
 //!   `α (δ_e + δ_f)`. `α ≤ 0.9 d_ef / (δ_e + δ_f)` for every candidate pair keeps at least 10% of
 //!   each distance, so no two edges can cross. With `δ` the largest vertex move and `d_min` the
 //!   smallest distance, this is at least the global bound `α ≤ 0.9 d_min / (2δ)`.
-//! - Reach: a pair outside the candidate list starts at least the broad-phase radius
-//!   `reach + margin` apart and approaches by at most `2 α δ`; `α ≤ margin / (2δ)` keeps it out
-//!   of the contact law's reach, so the list holds every interacting pair of the line search
-//!   (and every pair that could cross: the radius exceeds `2 α δ`).
+//! - Reach: a pair outside the candidate list was at least the broad-phase radius
+//!   `reach + margin` apart where the list was found, and has approached by at most twice the
+//!   largest vertex move since; `α ≤ slack / δ` ([`CandidateList::slack_m`]) keeps it out of the
+//!   contact law's reach, so the list holds every interacting pair of the line search (and
+//!   every pair that could cross: the radius exceeds the approach).
 //! - Obstacles: `α ≤ 0.9 gap / approach` per vertex and obstacle ([`super::Obstacle`]).
 
 use nalgebra::DVector;
 
-use super::contact::Candidate;
+use super::contact::CandidateList;
 use super::system::System;
 
 /// The caps on one step: each the largest admissible `α` (∞ where nothing limits it).
@@ -40,19 +41,15 @@ pub(crate) fn vertex_moves(system: &System, d: &DVector<f64>) -> Vec<f64> {
     (0..system.vertex_count()).map(|v| System::position(d, v).norm()).collect()
 }
 
-/// The caps for the direction `d` from `q`, with the candidate pairs at `q`.
-pub(crate) fn step_caps(
-    system: &System,
-    q: &DVector<f64>,
-    d: &DVector<f64>,
-    candidates: &[Candidate],
-) -> Caps {
+/// The caps for the direction `d` from `q`, with the candidate list brought to `q`.
+pub(crate) fn step_caps(system: &System, q: &DVector<f64>, d: &DVector<f64>, list: &CandidateList) -> Caps {
     let moves = vertex_moves(system, d);
     let edge_move = |e: usize| {
         let ends = system.topology.edges[e].ends;
         moves[ends[0]].max(moves[ends[1]])
     };
-    let contact = candidates
+    let contact = list
+        .pairs
         .iter()
         .map(|c| {
             let approach = edge_move(c.a) + edge_move(c.b);
@@ -60,11 +57,8 @@ pub(crate) fn step_caps(
         })
         .fold(f64::INFINITY, f64::min);
     let largest = moves.iter().copied().fold(0.0, f64::max);
-    let reach = if system.contact.is_some() && largest > 0.0 {
-        system.margin_m() / (2.0 * largest)
-    } else {
-        f64::INFINITY
-    };
+    let reach =
+        if system.contact.is_some() && largest > 0.0 { list.slack_m / largest } else { f64::INFINITY };
     let mut obstacle = f64::INFINITY;
     for o in &system.obstacles {
         for (v, &radius) in system.vertex_radius_m.iter().enumerate() {

@@ -9,9 +9,11 @@
 //! - Broad phase: each edge's box, grown by half the broad-phase radius, goes into the cells of
 //!   a uniform grid hashed by cell coordinates (cell side the largest grown box); pairs sharing
 //!   a cell whose exact centreline distance is below the broad-phase radius are the candidates.
-//!   It is rebuilt at every Newton iterate, with the radius `reach + margin`, so that a step
-//!   which moves no vertex further than `margin / 2` ([`super::caps`]) leaves every pair outside
-//!   the list out of reach.
+//! - The list of a step ([`CandidateList`], a Verlet list): found with the radius
+//!   `reach + margin`, so that while no vertex has moved further than `margin / 2` from where
+//!   it was found, every pair outside the list stays out of reach ([`super::caps`] keeps each
+//!   Newton step within that slack). At every Newton iterate the listed pairs' distances are
+//!   recomputed; the list is found anew once a vertex has used half the slack (`margin / 4`).
 
 use std::collections::HashMap;
 
@@ -41,6 +43,62 @@ pub(crate) struct Candidate {
     pub b: usize,
     /// Centreline distance (m).
     pub distance_m: f64,
+}
+
+/// The candidate pairs of a step, kept across its Newton iterates (the module's rule).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct CandidateList {
+    /// Vertex positions where the broad phase last ran.
+    found_at: Vec<f64>,
+    /// The pairs, with their distances at the latest positions.
+    pub pairs: Vec<Candidate>,
+    /// How much further any vertex may move before a pair outside the list could come within
+    /// reach: `margin / 2` less the largest move since the list was found (m; ∞ without contact).
+    pub slack_m: f64,
+}
+
+impl CandidateList {
+    /// The list at positions `x` (vertex `v` at `x[3v..3v+3]`), or an empty one without
+    /// contact (`broad_phase` `None`); `broad_phase` is `(reach + margin, margin)` (m).
+    pub(crate) fn new(topology: &ContactTopology, x: &[f64], broad_phase: Option<(f64, f64)>) -> Self {
+        match broad_phase {
+            Some((radius_m, margin_m)) => CandidateList {
+                found_at: x.to_vec(),
+                pairs: topology.candidates(x, radius_m),
+                slack_m: 0.5 * margin_m,
+            },
+            None => CandidateList { found_at: vec![], pairs: vec![], slack_m: f64::INFINITY },
+        }
+    }
+
+    /// Bring the list to positions `x`: the pairs' distances there, or the list found anew
+    /// there once the slack left is under half the initial `margin / 2`.
+    pub(crate) fn update(&mut self, topology: &ContactTopology, x: &[f64], broad_phase: Option<(f64, f64)>) {
+        let Some((_, margin_m)) = broad_phase else { return };
+        let moved = self
+            .found_at
+            .chunks_exact(3)
+            .zip(x.chunks_exact(3))
+            .map(|(a, b)| Vector3::new(b[0] - a[0], b[1] - a[1], b[2] - a[2]).norm())
+            .fold(0.0, f64::max);
+        if moved > 0.25 * margin_m {
+            *self = CandidateList::new(topology, x, broad_phase);
+            return;
+        }
+        self.slack_m = 0.5 * margin_m - moved;
+        self.pairs.par_iter_mut().for_each(|c| c.distance_m = topology.distance_m(x, c.a, c.b));
+    }
+
+    /// The pairs closer than `reach_m` (with a relative allowance of `10⁻⁹` for the round-off
+    /// of the distances): at the list's positions, the only pairs with any contact energy.
+    pub(crate) fn within(&self, reach_m: f64) -> Vec<Candidate> {
+        self.pairs.iter().filter(|c| c.distance_m < reach_m * (1.0 + 1e-9)).copied().collect()
+    }
+
+    /// The smallest centreline distance of the pairs (m; ∞ for none).
+    pub(crate) fn closest_m(&self) -> f64 {
+        self.pairs.iter().map(|c| c.distance_m).fold(f64::INFINITY, f64::min)
+    }
 }
 
 /// The edges of a scene and the pairs excluded from contact.
@@ -257,5 +315,49 @@ mod tests {
             }
             assert_eq!(found, all, "radius {radius}");
         }
+    }
+
+    #[test]
+    fn the_list_of_a_step_holds_every_pair_within_reach_until_it_is_found_anew() {
+        let n = 40;
+        let zigzag = |phase: f64| -> Vec<f64> {
+            (0..n)
+                .flat_map(|i| {
+                    let s = i as f64 * 0.25;
+                    [(s + phase).sin() * 2.0, (1.3 * s).cos(), 0.1 * s]
+                })
+                .collect()
+        };
+        let rest = vec![0.3; n - 1];
+        let topology = ContactTopology::new(&[(0, n, false, &rest)], &[]);
+        let (reach, margin) = (0.4, 0.4);
+        let broad_phase = Some((reach + margin, margin));
+        let x0 = zigzag(0.0);
+        let mut list = CandidateList::new(&topology, &x0, broad_phase);
+        assert_eq!(list.slack_m, 0.5 * margin);
+        // Moves under margin / 4 keep the list and spend its slack; the distances follow.
+        for phase in [0.01, 0.02, 0.03, 0.04, 0.05, 0.3] {
+            let x = zigzag(phase);
+            let moved = x0
+                .chunks(3)
+                .zip(x.chunks(3))
+                .map(|(a, b)| Vector3::from_column_slice(a).metric_distance(&Vector3::from_column_slice(b)))
+                .fold(0.0, f64::max);
+            list.update(&topology, &x, broad_phase);
+            if moved <= 0.25 * margin {
+                assert_eq!(list.slack_m, 0.5 * margin - moved, "phase {phase}");
+            } else {
+                assert_eq!(list.slack_m, 0.5 * margin, "found anew at phase {phase}");
+            }
+            for c in &list.pairs {
+                assert_eq!(c.distance_m, topology.distance_m(&x, c.a, c.b));
+            }
+            // Every pair within reach is listed, and `within` keeps exactly those.
+            let near: Vec<_> = topology.candidates(&x, reach).iter().map(|c| (c.a, c.b)).collect();
+            let listed: Vec<_> =
+                list.within(reach).iter().filter(|c| c.distance_m < reach).map(|c| (c.a, c.b)).collect();
+            assert_eq!(listed, near, "phase {phase}");
+        }
+        assert!(list.closest_m() > 0.0 && list.closest_m() < reach);
     }
 }

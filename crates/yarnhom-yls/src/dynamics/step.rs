@@ -17,7 +17,9 @@
 //!   `|∇_v Φ| h² / m_v ≤ tolerance · r` and `|∂Φ/∂θ_e| ≤ tolerance · k_e`.
 //! - Line search: from the capped fraction `α₀`, halve `α` until
 //!   `Φ(q + α d) ≤ Φ(q) + 10⁻⁴ α ∇Φ · d` (to the round-off of `Φ`'s parts) with `Φ` finite.
-//! - The broad phase is rebuilt at every Newton iterate ([`super::contact`]).
+//! - Contact pairs: the step's candidate list ([`super::contact::CandidateList`]) is brought
+//!   to every Newton iterate; the Hessian and gradient take the pairs within the law's reach
+//!   there (the others contribute exactly nothing), the caps and the line search all of them.
 
 use nalgebra::DVector;
 use yarnhom_sparse::SpdSolver;
@@ -155,10 +157,7 @@ impl Counters {
 
 /// The candidate contact pairs at `q` (none without contact).
 pub(crate) fn candidates_at(system: &System, q: &DVector<f64>) -> Vec<Candidate> {
-    match system.broad_phase_radius_m() {
-        Some(radius) => system.topology.candidates(&q.as_slice()[..3 * system.vertex_count()], radius),
-        None => vec![],
-    }
+    system.candidate_list(q).pairs
 }
 
 /// The state after a step of `time_step_s` from `state`, and what it took.
@@ -178,9 +177,12 @@ pub(crate) fn advance(
     let mut counters = Counters::default();
     let options = system.options;
     let mut step_m = f64::NAN;
+    let mut list = system.candidate_list(&q);
+    let reach_m = system.contact.map_or(0.0, |law| law.reach_m());
     for iteration in 0..options.max_newton_iterations {
-        let candidates = candidates_at(system, &q);
-        let evaluation = context.evaluate(&q, &candidates, Want::Derivatives);
+        let x = &q.as_slice()[..3 * system.vertex_count()];
+        list.update(&system.topology, x, system.broad_phase_m());
+        let evaluation = context.evaluate(&q, &list.within(reach_m), Want::Derivatives);
         if !evaluation.parts.total().is_finite() {
             return Err(StepError::Diverged { iteration, what: "incremental potential" });
         }
@@ -196,14 +198,14 @@ pub(crate) fn advance(
                 iterations: iteration + 1,
                 counters,
                 parts: evaluation.parts,
-                candidates: &candidates,
+                closest_m: list.closest_m(),
             };
             return finish(system, state, q, time_s, time_step_s, report);
         }
-        let caps = step_caps(system, &q, &direction, &candidates);
+        let caps = step_caps(system, &q, &direction, &list);
         counters.count_caps(&caps);
         let search =
-            LineSearch { context: &context, candidates: &candidates, max_cuts: options.max_line_search_cuts };
+            LineSearch { context: &context, candidates: &list.pairs, max_cuts: options.max_line_search_cuts };
         q = search
             .run(&q, &direction, &evaluation, caps.fraction(), &mut counters.line_search_cuts)
             .ok_or(StepError::LineSearchFailed { iteration, step_m })?;
@@ -221,7 +223,7 @@ fn move_handles(system: &System, q_n: &DVector<f64>, time_s: f64) -> Result<DVec
     }
     let d = &q - q_n;
     if d.amax() > 0.0 {
-        let caps = step_caps(system, q_n, &d, &candidates_at(system, q_n));
+        let caps = step_caps(system, q_n, &d, &system.candidate_list(q_n));
         let safe_fraction = caps.contact.min(caps.reach).min(caps.obstacle);
         if safe_fraction < 1.0 {
             return Err(StepError::HandleMoveTooFar { safe_fraction });
@@ -355,11 +357,12 @@ impl LineSearch<'_> {
 }
 
 /// What a converged solve hands to [`finish`].
-struct Report<'a> {
+struct Report {
     iterations: usize,
     counters: Counters,
     parts: PotentialParts,
-    candidates: &'a [Candidate],
+    /// The smallest centreline distance of the candidate pairs (m).
+    closest_m: f64,
     /// When the step started (for its wall time).
     started: std::time::Instant,
 }
@@ -371,7 +374,7 @@ fn finish(
     q: DVector<f64>,
     time_s: f64,
     time_step_s: f64,
-    report: Report<'_>,
+    report: Report,
 ) -> Result<(State, StepReport), StepError> {
     let positions = 3 * system.vertex_count();
     let velocity = (q.rows(0, positions) - state.q.rows(0, positions)) / time_step_s;
@@ -386,7 +389,6 @@ fn finish(
         obstacle_j: report.parts.obstacle,
         gravity_j: gravity_energy_j(system, &q),
     };
-    let closest = report.candidates.iter().map(|c| c.distance_m).fold(f64::INFINITY, f64::min);
     let c = report.counters;
     let step = StepReport {
         time_s,
@@ -396,7 +398,7 @@ fn finish(
         reach_caps: c.reach_caps,
         obstacle_caps: c.obstacle_caps,
         hessian_shifts: c.hessian_shifts,
-        closest_distance_radii: closest / system.radius_m,
+        closest_distance_radii: report.closest_m / system.radius_m,
         energies,
         wall_time_s: report.started.elapsed().as_secs_f64(),
     };

@@ -5,7 +5,7 @@
 use nalgebra::{DVector, Vector3};
 use yarnhom_rod::{ContactLaw, Rod};
 
-use super::contact::ContactTopology;
+use super::contact::{CandidateList, ContactTopology};
 use super::damping::{Damping, yarn_windows};
 use super::handles::Handle;
 use yarnhom_artifacts::GlueSpring;
@@ -282,9 +282,14 @@ impl System {
         Vector3::new(q[3 * v], q[3 * v + 1], q[3 * v + 2])
     }
 
-    /// The contact reach (m; 0 without contact) and the broad-phase radius `reach + margin`.
-    pub(crate) fn broad_phase_radius_m(&self) -> Option<f64> {
-        self.contact.map(|law| law.reach_m() + self.margin_m())
+    /// The broad-phase radius `reach + margin` and the margin (m), without contact `None`.
+    pub(crate) fn broad_phase_m(&self) -> Option<(f64, f64)> {
+        self.contact.map(|law| (law.reach_m() + self.margin_m(), self.margin_m()))
+    }
+
+    /// The candidate contact pairs at `q` ([`CandidateList`]).
+    pub(crate) fn candidate_list(&self, q: &DVector<f64>) -> CandidateList {
+        CandidateList::new(&self.topology, &q.as_slice()[..3 * self.vertex_count()], self.broad_phase_m())
     }
 
     /// The broad-phase margin (m).
