@@ -281,6 +281,26 @@ impl Rod {
         (energy, gradient, triplets)
     }
 
+    /// The elastic energy at `q` attributed to the vertices (J): each edge's stretching
+    /// half to either end, each bending-twisting element to its centre vertex. The values sum
+    /// to [`Rod::assemble`]'s energy; over a region they give its energy.
+    pub fn vertex_energies(&self, q: &DVector<f64>) -> Vec<f64> {
+        let mut energies = vec![0.0; self.vertices];
+        for (e, &rest) in self.rest_lengths.iter().enumerate() {
+            let (a, b) = (e, (e + 1) % self.vertices);
+            let (w, _, _) =
+                stretch_energy(&self.material.stretch, rest, &Self::position(q, a), &Self::position(q, b));
+            energies[a] += 0.5 * w;
+            energies[b] += 0.5 * w;
+        }
+        for ((v, e_in, e_out), (element, reference)) in
+            self.bend_vertices().zip(self.elements.iter().zip(&self.references))
+        {
+            energies[v] += element.energy(reference, &self.element_dofs(q, v, e_in, e_out));
+        }
+        energies
+    }
+
     /// The reference frames of the bending-twisting elements, which
     /// [`Rod::update_references`] moves with the rod (a simulation's state besides its DOFs).
     pub fn references(&self) -> &[BendTwistReference] {
@@ -375,6 +395,24 @@ mod tests {
     }
 
     #[test]
+    fn the_vertex_energies_sum_to_the_rod_energy_in_any_configuration() {
+        for (positions, closed) in [(helix(17), false), (helix(12), true)] {
+            let rod = Rod::at_rest(&positions, closed, material(), [0.2, -0.4, 1.0]);
+            let m = if closed { 12 } else { 16 };
+            let moved: Vec<[f64; 3]> = positions
+                .iter()
+                .enumerate()
+                .map(|(i, p)| [p[0] * 1.1, p[1] + 0.01 * i as f64, p[2]])
+                .collect();
+            let twists: Vec<f64> = (0..m).map(|e| 0.05 * e as f64).collect();
+            let q = rod.dofs_of(&moved, &twists);
+            let (energy, _, _) = rod.assemble(&q);
+            let sum: f64 = rod.vertex_energies(&q).iter().sum();
+            assert!(energy > 0.0 && (sum - energy).abs() <= 1e-12 * energy, "{sum} vs {energy}");
+        }
+    }
+
+    #[test]
     fn at_rest_is_the_explicit_constructor_fed_with_the_rest_data_read_off_the_positions() {
         let hint = [0.2, -0.4, 1.0];
         for (positions, closed) in [(helix(17), false), (helix(12), true)] {
@@ -415,8 +453,17 @@ mod tests {
             .sum();
         let stretch: f64 =
             rest.rest_lengths_m.iter().map(|&l| 0.5 * 100.0 * (0.25 / l - 1.0).powi(2) * l).sum();
-        let rod = Rod::with_rest_shape(&positions, false, material(), rest);
+        let rod = Rod::with_rest_shape(&positions, false, material(), rest.clone());
         let (energy, _, _) = rod.assemble(&rod.dofs_of(&positions, &[0.0; 8]));
         assert!((energy - expected - stretch).abs() < 1e-12 * energy, "{energy} vs {}", expected + stretch);
+        // Per vertex: half of each adjacent edge's stretching, and the bend vertex's own term.
+        let energies = rod.vertex_energies(&rod.dofs_of(&positions, &[0.0; 8]));
+        let edge =
+            |e: usize| 0.5 * 100.0 * (0.25 / rest.rest_lengths_m[e] - 1.0).powi(2) * rest.rest_lengths_m[e];
+        assert!((energies[0] - 0.5 * edge(0)).abs() < 1e-15 && (energies[8] - 0.5 * edge(7)).abs() < 1e-15);
+        let ([k1, k2], m) = (rest.rest_curvature[2], rest.rest_twist_rad[2]);
+        let bend =
+            (2.0 * k1 * k1 + 3.0 * k2 * k2 + 1.5 * m * m) / (rest.rest_lengths_m[2] + rest.rest_lengths_m[3]);
+        assert!((energies[3] - bend - 0.5 * (edge(2) + edge(3))).abs() < 1e-14, "{}", energies[3]);
     }
 }

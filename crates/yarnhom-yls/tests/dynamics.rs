@@ -67,8 +67,9 @@ fn elastica_tip_drop(q: f64, length: f64, ei: f64) -> f64 {
 /// `q L³ / EI = load`, run with damping until it rests. The clamp is the first edge (its two
 /// vertices a handle), centred on the origin: the bending element at the second vertex spans
 /// half an edge on either side, so the beam starts at the clamp edge's midpoint, and `segments`
-/// free edges of length `L / (segments + 1/2)` follow.
-fn cantilever_at_rest(segments: usize, load: f64) -> (f64, usize) {
+/// free edges of length `L / (segments + 1/2)` follow. Also returns the clamp's vertical
+/// force over the yarn's weight.
+fn cantilever_at_rest(segments: usize, load: f64) -> (f64, usize, f64) {
     let gravity = 9.81;
     let h = 1.0 / (segments as f64 + 0.5);
     // Nearly inextensible (axial strain below 1e-5).
@@ -95,7 +96,9 @@ fn cantilever_at_rest(segments: usize, load: f64) -> (f64, usize) {
             break;
         }
     }
-    (-simulation.positions_m()[tip][2], steps)
+    let weight: f64 = simulation.vertex_masses_kg().iter().sum::<f64>() * gravity;
+    let clamp = simulation.handle_forces_n()[0];
+    (-simulation.positions_m()[tip][2], steps, clamp[2] / weight)
 }
 
 #[test]
@@ -104,7 +107,9 @@ fn a_cantilever_under_its_own_weight_comes_to_rest_at_the_elastica() {
     // Large deflection: q L³ / EI = 3.
     let reference = elastica_tip_drop(3.0, 1.0, 1.0);
     assert!(reference > 0.2, "the load gives a large deflection ({reference})");
-    let (drop, steps) = cantilever_at_rest(segments, 3.0);
+    let (drop, steps, clamp) = cantilever_at_rest(segments, 3.0);
+    // At rest the clamp carries the whole weight.
+    assert!((clamp - 1.0).abs() < 1e-5, "the clamp holds {clamp} of the weight");
     let error = drop / reference - 1.0;
     println!(
         "q L³/EI = 3: tip drop {drop:.5} L, elastica {reference:.5} L, error {error:+.2e}, {steps} steps"
@@ -115,7 +120,7 @@ fn a_cantilever_under_its_own_weight_comes_to_rest_at_the_elastica() {
     let linear = load / 8.0;
     let reference = elastica_tip_drop(load, 1.0, 1.0);
     assert!((reference / linear - 1.0).abs() < 1e-4, "elastica {reference} vs linear {linear}");
-    let (drop, steps) = cantilever_at_rest(segments, load);
+    let (drop, steps, _) = cantilever_at_rest(segments, load);
     let error = drop / linear - 1.0;
     println!(
         "q L³/EI = 0.01: tip drop {drop:.4e} L, q L⁴/(8 EI) = {linear:.4e} L, error {error:+.2e}, {steps} steps"
@@ -226,6 +231,11 @@ fn a_yarn_falling_onto_a_crossing_yarn_on_a_plane_never_touches_it() {
     assert!(closest > 0.0, "the yarns touched");
     // B lies on A: the contact acts (below 2 radii) and holds it (above 1 radius).
     assert!(final_distance < 2.0 && final_distance > 1.0, "{final_distance}");
+    // The stored energy, shared among the vertices, sums to the state's.
+    let e = simulation.energies();
+    let shared: f64 = simulation.vertex_energies_j().iter().sum();
+    let stored = e.elastic_j + e.glue_j + e.contact_j;
+    assert!(e.contact_j > 0.0 && (shared - stored).abs() <= 1e-12 * stored, "{shared} vs {stored}");
     // Both yarns rest above the plane.
     let lowest = simulation.positions_m().iter().map(|p| p[2]).fold(f64::INFINITY, f64::min);
     assert!(lowest > R, "a vertex at {lowest} m sank into the plane");

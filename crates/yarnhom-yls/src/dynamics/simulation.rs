@@ -5,10 +5,12 @@ use yarnhom_sparse::SpdSolver;
 
 use super::input::InputError;
 use super::potential::{StepContext, Want};
+use super::springs::glue_energy;
 use super::step::{
     Energies, State, StepError, StepReport, advance, candidates_at, gravity_energy_j, kinetic_energy_j,
 };
 use super::system::{Scene, System};
+use yarnhom_rod::contact_energy_only;
 
 /// A scene being simulated.
 pub struct Simulation {
@@ -134,6 +136,56 @@ impl Simulation {
             .map(|c| c.distance_m)
             .fold(f64::INFINITY, f64::min);
         closest / self.system.radius_m
+    }
+
+    /// The stored energy of the current state attributed to the vertices (J): the rods'
+    /// ([`yarnhom_rod::Rod::vertex_energies`]), half of each glue spring's to either end, and a
+    /// quarter of each contact pair's to each of its edges' ends. Summed over a region (the
+    /// copies of one tile, say) they give its energy; over all vertices, the elastic, glue and
+    /// contact energies of [`Simulation::energies`].
+    pub fn vertex_energies_j(&self) -> Vec<f64> {
+        let (system, q) = (&self.system, &self.state.q);
+        let mut energies = vec![0.0; system.vertex_count()];
+        for (y, rod) in system.rods.iter().enumerate() {
+            let first = system.vertex_offsets[y];
+            for (k, w) in rod.vertex_energies(&system.rod_q(y, q)).into_iter().enumerate() {
+                energies[first + k] += w;
+            }
+        }
+        for spring in &system.glue {
+            let [a, b] = spring.vertices.map(|v| v as usize);
+            let (xa, xb) = (System::position(q, a), System::position(q, b));
+            let (w, _, _) = glue_energy(spring.stiffness_n_m, spring.rest_length_m, &xa, &xb);
+            energies[a] += 0.5 * w;
+            energies[b] += 0.5 * w;
+        }
+        if let Some(law) = system.contact {
+            let edges = &system.topology.edges;
+            for c in candidates_at(system, q) {
+                let ends = [edges[c.a].ends, edges[c.b].ends].concat();
+                let x = ends.iter().map(|&v| System::position(q, v)).collect::<Vec<_>>();
+                let (ra, rb) = (edges[c.a].rest_length_m, edges[c.b].rest_length_m);
+                let w = contact_energy_only(&law, [&x[0], &x[1], &x[2], &x[3]], ra, rb);
+                ends.iter().for_each(|&v| energies[v] += 0.25 * w);
+            }
+        }
+        energies
+    }
+
+    /// Per handle, the force (N) it applies to its vertices to hold them in static equilibrium
+    /// in the current state: the sum over its vertices of `∂(V - gravity's work)/∂x_v`, with `V`
+    /// the stored energy and the obstacles' barriers. Inertia and damping are left out, so at
+    /// rest (a quasi-static run) it is the handle's reaction.
+    pub fn handle_forces_n(&self) -> Vec<[f64; 3]> {
+        let (system, q) = (&self.system, &self.state.q);
+        let gradient = StepContext::at_rest(system, q)
+            .evaluate(q, &candidates_at(system, q), Want::Derivatives)
+            .gradient;
+        let mut forces = vec![[0.0; 3]; system.handles.len()];
+        for &(v, h, _) in &system.held {
+            (0..3).for_each(|k| forces[h][k] += gradient[3 * v + k]);
+        }
+        forces
     }
 
     /// Symbolic analyses of the Hessian's pattern so far (reused while the pattern stays within
