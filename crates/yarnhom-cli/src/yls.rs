@@ -26,8 +26,8 @@ pub enum YlsCommand {
     /// Simulate a scene with a swatch in place of the cloth: a built-in (stretch-x, stretch-y,
     /// drape), a yarnhom scene JSON or an ARCSim-HYLC scene. Writes the yarns per frame
     /// (`/yarn/frame`), energies and the closest centreline distance (`/metrics`) and Newton
-    /// statistics per step (`/solver`). Obstacle friction and the shell's Rayleigh damping are
-    /// not used; the yarns get Kaldor's damping of non-rigid motion.
+    /// statistics per step (`/solver`). The shell's Rayleigh damping is not used; the yarns get
+    /// Kaldor's damping of non-rigid motion.
     Simulate(SimulateArgs),
     /// Record training sequences: `--variations` randomized variants of each scene (handle
     /// motions scaled by 0.5-1.5, sphere obstacles shifted by up to 10% of the swatch, the

@@ -1,6 +1,7 @@
 #![doc = include_str!("../README.md")]
 
 pub mod dynamics;
+pub mod interior;
 pub mod record;
 pub mod run;
 pub mod scene;

@@ -8,9 +8,10 @@
 //!   (so a bar means the same on a swatch of any size); a sphere holds the vertices inside it
 //!   (or the nearest one), at the scene's absolute position; both follow the scene's motions.
 //!   A handle that holds no vertex is an error;
-//! - **obstacles**: spheres and planes, as barriers on the gap between a yarn's surface and the
-//!   obstacle ([`RunSettings::obstacle_activation_radii`], [`RunSettings::obstacle_stiffness_n_m`]);
-//!   boxes are refused (not yet modelled); friction is not modelled at yarn level;
+//! - **obstacles**: spheres, planes and boxes, as barriers on the gap between a yarn's surface
+//!   and the obstacle ([`RunSettings::obstacle_activation_radii`],
+//!   [`RunSettings::obstacle_stiffness_n_m`]), with the scene's Coulomb friction (`obs_friction`)
+//!   applied as the shell simulator applies it ([`Obstacle::apply_friction`]);
 //! - **gravity**: the scene's; **air drag**: the scene's wind on the yarn segments, the
 //!   swatch's area shared among them by rest length ([`YarnWind`]);
 //! - **damping**: the scene's Rayleigh terms are the shell's; the yarns get Kaldor et al.
@@ -63,14 +64,6 @@ pub enum RunError {
     /// The scene is not usable.
     #[error(transparent)]
     Scene(#[from] yarnhom_shell::scene::SceneError),
-    /// Part of the scene has no yarn-level model yet.
-    #[error("scene '{scene}': {what} are not modelled at yarn level yet")]
-    Unsupported {
-        /// The scene.
-        scene: String,
-        /// What.
-        what: &'static str,
-    },
     /// A handle holds no yarn vertex.
     #[error(
         "scene '{scene}': handle {handle} holds no yarn vertex of the swatch (the swatch is centred on the origin)"
@@ -120,11 +113,8 @@ pub fn place(
         dynamics.yarns.iter().flat_map(|y| y.positions_m.iter().map(|&p| Vector3::from(p))).collect();
     dynamics.handles = handles(swatch, scene, &positions)?;
     let radius = swatch.yarns.iter().map(|y| y.radius_m).fold(0.0, f64::max);
-    dynamics.obstacles = scene
-        .obstacles
-        .iter()
-        .map(|o| obstacle(o, radius, settings, &scene.name))
-        .collect::<Result<_, _>>()?;
+    dynamics.obstacles =
+        scene.obstacles.iter().map(|o| obstacle(o, radius, settings, scene.contact.friction)).collect();
     dynamics.gravity_m_s2 = scene.gravity;
     dynamics.wind = (!scene.wind.is_none()).then(|| wind(swatch, &scene.wind));
     dynamics.damping = Some(Damping::kaldor(settings.damping_rate_per_s));
@@ -182,27 +172,21 @@ fn keyframes(keys: &[(f64, [f64; 3])]) -> Vec<Keyframe> {
     keys.iter().map(|&(time_s, translation_m)| Keyframe { time_s, translation_m }).collect()
 }
 
-/// A scene obstacle as a yarn-level barrier.
-fn obstacle(
-    o: &ShellObstacle,
-    radius_m: f64,
-    settings: &RunSettings,
-    scene: &str,
-) -> Result<Obstacle, RunError> {
+/// A scene obstacle as a yarn-level barrier with the scene's friction coefficient.
+fn obstacle(o: &ShellObstacle, radius_m: f64, settings: &RunSettings, friction: f64) -> Obstacle {
     let shape = match *o {
         ShellObstacle::Sphere { center, radius } => {
             ObstacleShape::Sphere { centre_m: center, radius_m: radius }
         }
         ShellObstacle::Plane { point, normal } => ObstacleShape::Plane { point_m: point, normal },
-        ShellObstacle::Box { .. } => {
-            return Err(RunError::Unsupported { scene: scene.into(), what: "box obstacles" });
-        }
+        ShellObstacle::Box { min, max } => ObstacleShape::Box { min_m: min, max_m: max },
     };
-    Ok(Obstacle {
+    Obstacle {
         shape,
         activation_distance_m: settings.obstacle_activation_radii * radius_m,
         stiffness_n_m: settings.obstacle_stiffness_n_m,
-    })
+        friction,
+    }
 }
 
 fn check_settings(settings: &RunSettings) -> Result<(), RunError> {

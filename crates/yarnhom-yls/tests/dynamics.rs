@@ -211,6 +211,7 @@ fn crossing_scene(gap: f64) -> Scene {
         shape: ObstacleShape::Plane { point_m: [0.0; 3], normal: [0.0, 0.0, 1.0] },
         activation_distance_m: 0.5 * R,
         stiffness_n_m: 1.0,
+        friction: 0.0,
     }];
     scene.damping = Some(Damping::kaldor(5.0));
     scene
@@ -492,4 +493,53 @@ fn a_falling_yarn_reaches_the_terminal_speed_of_the_wind_law() {
     let expected = 1.0 - (1.0 - h * rate).powi(steps);
     let v = simulation.velocities_m_s()[10][0];
     assert!((v - expected).abs() < 1e-6, "{v} m/s against {expected} m/s");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Obstacle friction.
+
+/// A straight yarn resting on the plane z = 0 under gravity, then launched along x at `v0`
+/// with friction `mu` (no damping): how far it slides in `duration`, and its speed at the end.
+fn slide_on_a_plane(mu: f64, v0: f64, duration: f64) -> (f64, f64) {
+    let yarn = straight(11, [0.0, 0.0, 1.2 * R], [0.02, 0.0, 0.0], R, yarn_material(), 0.01);
+    let mut scene = Scene::new(vec![yarn]);
+    scene.gravity_m_s2 = [0.0, 0.0, -9.81];
+    scene.obstacles = vec![Obstacle {
+        shape: ObstacleShape::Plane { point_m: [0.0; 3], normal: [0.0, 0.0, 1.0] },
+        activation_distance_m: 0.5 * R,
+        stiffness_n_m: 10.0,
+        friction: mu,
+    }];
+    let mut simulation = Simulation::new(&scene).expect("valid scene");
+    // Come to rest on the plane: long steps, whose numerical dissipation stops the bouncing
+    // on the barrier (friction has nothing to act on yet).
+    for _ in 0..60 {
+        simulation.step(0.02).expect("the step converges");
+    }
+    let h = 2e-4;
+    let rest = simulation.velocities_m_s().iter().map(|v| v[2].abs()).fold(0.0, f64::max);
+    assert!(rest < 1e-6, "the yarn rests on the plane ({rest} m/s)");
+    let start = simulation.positions_m()[5][0];
+    let launched = vec![[v0, 0.0, 0.0]; 11];
+    simulation.set_velocities_m_s(&launched).expect("valid velocities");
+    let steps = (duration / h).round() as usize;
+    for _ in 0..steps {
+        simulation.step(h).expect("the step converges");
+    }
+    let speed = simulation.velocities_m_s().iter().map(|v| v[0].abs()).fold(0.0, f64::max);
+    (simulation.positions_m()[5][0] - start, speed)
+}
+
+#[test]
+fn friction_on_an_obstacle_stops_a_sliding_yarn_at_coulombs_distance() {
+    let (mu, v0, g) = (0.3, 0.1, 9.81);
+    // Coulomb: deceleration μ g, stopping distance v0² / (2 μ g) = 1.70 mm after 34 ms.
+    let expected = v0 * v0 / (2.0 * mu * g);
+    let (slid, speed) = slide_on_a_plane(mu, v0, 0.05);
+    println!("slid {slid:.4e} m, Coulomb {expected:.4e} m, final speed {speed:.1e} m/s");
+    assert!((slid / expected - 1.0).abs() < 0.02, "slid {slid} m, expected {expected} m");
+    assert_eq!(speed, 0.0, "static friction holds the yarn");
+    // Without friction it keeps its speed.
+    let (slid, speed) = slide_on_a_plane(0.0, v0, 0.01);
+    assert!((slid / (v0 * 0.01) - 1.0).abs() < 1e-6 && (speed / v0 - 1.0).abs() < 1e-6, "{slid} {speed}");
 }

@@ -72,6 +72,7 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
     let scene = yarnhom_shell::Scene { handles: vec![], ..scene };
     let placed = place(&swatch, &scene, &RunSettings::default()).expect("places");
     assert_eq!(placed.obstacles.len(), 1, "the drape's sphere");
+    assert_eq!(placed.obstacles[0].friction, 0.052, "the published drape's obs_friction");
     let wind = placed.wind.expect("the published drape's air drag");
     assert_eq!(wind.density_kg_m3, scene.wind.density_kg_m3);
     let length: f64 = swatch.rest_length_m.iter().sum();
@@ -117,7 +118,7 @@ fn frames_are_recorded_as_yarn_frames_metrics_and_solver_steps() {
 }
 
 #[test]
-fn box_obstacles_and_bad_settings_are_refused() {
+fn box_obstacles_become_barriers_and_bad_settings_are_refused() {
     let swatch = stock_swatch([2, 2]);
     let scene = yarnhom_shell::Scene {
         obstacles: vec![yarnhom_shell::contact::Obstacle::Box {
@@ -126,8 +127,10 @@ fn box_obstacles_and_bad_settings_are_refused() {
         }],
         ..yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in")
     };
-    let error = place(&swatch, &scene, &RunSettings::default()).map(|_| ()).expect_err("a box");
-    assert!(error.to_string().contains("box obstacles are not modelled"), "{error}");
+    let placed = place(&swatch, &scene, &RunSettings::default()).expect("places");
+    let box_shape =
+        yarnhom_yls::dynamics::ObstacleShape::Box { min_m: [-1.0, -1.0, -2.0], max_m: [1.0, 1.0, -1.0] };
+    assert_eq!(placed.obstacles[0].shape, box_shape);
     let scene = yarnhom_shell::Scene::builtin("stretch-x").expect("a built-in");
     for settings in [
         RunSettings { steps_per_frame: 0, ..RunSettings::default() },

@@ -16,14 +16,16 @@
 //!   any [`ContactLaw`]; [`Scene::new`] starts without): between every two edges within the law's
 //!   reach, except two edges of one yarn that share a vertex
 //!   or are one edge apart, and two edges with ends joined by a glue spring.
-//! - **Broad phase**: a uniform spatial hash rebuilt at every Newton iterate, radius
-//!   `reach + margin` (margin [`SolverOptions::broad_phase_margin_radii`], 2 yarn radii).
+//! - **Broad phase**: a uniform spatial hash, radius `reach + margin` (margin
+//!   [`SolverOptions::broad_phase_margin_radii`], 2 yarn radii), kept over a step's Newton
+//!   iterates as a Verlet list (found anew once a vertex has moved `margin / 4`).
 //! - **Step cap**: `α ≤ 0.9 d_ef / (δ_e + δ_f)` per candidate pair (at least the global
-//!   `0.9 d_min / (2δ)`), `α ≤ margin / (2δ)` for pairs outside the list, `α ≤ 0.9 gap / approach`
-//!   per vertex and obstacle; so centrelines never cross and vertices never enter obstacles.
-//! - **Obstacles** ([`Obstacle`]): planes and spheres, the IPC log barrier on the gap between
-//!   the yarn's surface and the obstacle within an activation distance given per obstacle; no
-//!   friction.
+//!   `0.9 d_min / (2δ)`), `α ≤ slack / δ` for pairs outside the list (`slack` = `margin / 2`
+//!   less the largest move since the list was found), `α ≤ 0.9 gap / approach` per vertex and
+//!   obstacle; so centrelines never cross and vertices never enter obstacles.
+//! - **Obstacles** ([`Obstacle`]): planes, spheres and axis-aligned boxes, the IPC log barrier on
+//!   the gap between the yarn's surface and the obstacle within an activation distance given per
+//!   obstacle; Coulomb friction on the velocities after each step, as the shell simulator's.
 //! - **Handles** ([`Handle`]): keyframed rigid translations, piecewise linear; held vertices are
 //!   Dirichlet conditions, eliminated from the solve. They move to their new positions at a
 //!   step's start, under the same caps: a move the caps would cut is an error.

@@ -377,7 +377,8 @@ fn finish(
     report: Report,
 ) -> Result<(State, StepReport), StepError> {
     let positions = 3 * system.vertex_count();
-    let velocity = (q.rows(0, positions) - state.q.rows(0, positions)) / time_step_s;
+    let mut velocity = (q.rows(0, positions) - state.q.rows(0, positions)) / time_step_s;
+    apply_friction(system, &q, &mut velocity, time_step_s);
     if !(q.iter().all(|x| x.is_finite()) && velocity.iter().all(|x| x.is_finite())) {
         return Err(StepError::Diverged { iteration: report.iterations, what: "state" });
     }
@@ -403,6 +404,20 @@ fn finish(
         wall_time_s: report.started.elapsed().as_secs_f64(),
     };
     Ok((State { q, velocity, time_s }, step))
+}
+
+/// Obstacle friction ([`super::Obstacle::apply_friction`]) on the end velocities of the free
+/// vertices at `q`.
+fn apply_friction(system: &System, q: &DVector<f64>, velocity: &mut DVector<f64>, time_step_s: f64) {
+    for obstacle in system.obstacles.iter().filter(|o| o.friction > 0.0) {
+        for (v, (&m, &radius)) in system.masses_kg.iter().zip(&system.vertex_radius_m).enumerate() {
+            if system.free_index[3 * v].is_some() {
+                let mut u = System::position(velocity, v);
+                obstacle.apply_friction(&System::position(q, v), radius, &mut u, m, time_step_s);
+                velocity.fixed_rows_mut::<3>(3 * v).copy_from(&u);
+            }
+        }
+    }
 }
 
 /// `½ Σ m_v |v_v|²`.

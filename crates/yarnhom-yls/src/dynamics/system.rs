@@ -346,6 +346,10 @@ fn validate_obstacles(obstacles: &[Obstacle]) -> Result<(), InputError> {
                 (point_m.into_iter().chain(normal).collect::<Vec<_>>(), Vector3::from(normal).norm())
             }
             ObstacleShape::Sphere { centre_m, radius_m } => (centre_m.to_vec(), radius_m),
+            ObstacleShape::Box { min_m, max_m } => {
+                let thinnest = (0..3).map(|k| max_m[k] - min_m[k]).fold(f64::INFINITY, f64::min);
+                (min_m.into_iter().chain(max_m).collect(), thinnest)
+            }
         };
         if !numbers.iter().all(|x| x.is_finite()) {
             return Err(InputError::Parameter {
@@ -354,7 +358,7 @@ fn validate_obstacles(obstacles: &[Obstacle]) -> Result<(), InputError> {
                 value: f64::NAN,
             });
         }
-        positive(&format!("size of obstacle {i} (normal length or radius)"), size)?;
+        positive(&format!("size of obstacle {i} (normal length, radius or box side)"), size)?;
     }
     Ok(())
 }

@@ -44,6 +44,7 @@ fn scene(rng: &mut u64) -> Scene {
         shape: ObstacleShape::Plane { point_m: [0.0, 0.0, 0.0], normal: [0.0, 0.1, 1.0] },
         activation_distance_m: 0.05,
         stiffness_n_m: 3.0,
+        friction: 0.0,
     }];
     scene.handles = vec![Handle::fixed(vec![0, 1])];
     scene.damping = Some(Damping { window_vertices: 4, rate_per_s: 7.0 });
