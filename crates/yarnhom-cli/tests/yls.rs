@@ -47,6 +47,21 @@ fn a_swatch_is_cut_and_a_stretch_is_simulated_on_it() {
     assert_eq!(frames.iter().map(|f| f.frame).collect::<Vec<_>>(), vec![0, 1]);
     assert!(frames[1].positions_m.iter().all(|p| p.iter().all(|x| x.is_finite())));
 
+    // `diff` compares yarn-level traces frame by frame: a rerun is equal, another scene is not.
+    ok(&["yls", "simulate", "stretch-x", "--swatch", "s.swatch.yh", "--frames", "1", "-o", "again.mcap"], d);
+    assert_eq!(yarnhom(&["diff", "run.mcap", "again.mcap"], d).status.code(), Some(0));
+    ok(&["yls", "simulate", "stretch-y", "--swatch", "s.swatch.yh", "--frames", "1", "-o", "y.mcap"], d);
+    let differs = yarnhom(&["diff", "run.mcap", "y.mcap"], d);
+    assert_eq!(differs.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&differs.stdout).contains("/yarn/frame"));
+    // `rerun` draws it (yarns as line strips, the held vertices as points); the rerun CLI, where
+    // installed, checks the recording.
+    let logged = yarnhom(&["rerun", "run.mcap", "--save", "run.rrd"], d);
+    assert!(logged.status.success(), "{}", String::from_utf8_lossy(&logged.stderr));
+    if let Ok(verify) = Command::new("rerun").args(["rrd", "verify", "run.rrd"]).current_dir(d).output() {
+        assert!(verify.status.success(), "{}", String::from_utf8_lossy(&verify.stderr));
+    }
+
     fails_with(
         &["yls", "swatch", STOCK, "--model", "table4.1:stock", "--size", "0.001x0.3", "-o", "x.yh"],
         d,

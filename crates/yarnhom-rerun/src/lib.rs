@@ -4,12 +4,12 @@ use std::collections::HashMap;
 use std::io::Read;
 
 pub use rerun;
-use rerun::{LineStrips3D, Mesh3D, RecordingStream, Scalars};
+use rerun::{LineStrips3D, Mesh3D, Points3D, RecordingStream, Scalars};
 
 use yarnhom_trace::export::{boundary_triangles, check_tet_topology};
 use yarnhom_trace::{
     MeshFrame, MeshTopology, RveSample, SolverIteration, SolverStep, TetFrame, TetTopology, TraceError,
-    TraceMessage, TraceReader, Truncation, YarnFrame,
+    TraceMessage, TraceReader, Truncation, YarnFrame, YarnNodes,
 };
 
 /// Errors of the rerun logger.
@@ -60,12 +60,14 @@ pub struct RerunLogger<'a> {
     meshes: HashMap<String, usize>,
     /// Triangles of each mesh (surface meshes and tet boundaries), for normals.
     triangles: HashMap<String, Vec<[u32; 3]>>,
+    /// The vertices handles hold, per yarn set (from `/yarn/nodes`).
+    held: HashMap<String, Vec<usize>>,
 }
 
 impl<'a> RerunLogger<'a> {
     /// A logger writing into `rec`.
     pub fn new(rec: &'a RecordingStream) -> Self {
-        Self { rec, meshes: HashMap::new(), triangles: HashMap::new() }
+        Self { rec, meshes: HashMap::new(), triangles: HashMap::new(), held: HashMap::new() }
     }
 
     /// Logs one message; returns `false` if its topic is not drawn.
@@ -73,6 +75,9 @@ impl<'a> RerunLogger<'a> {
         match message {
             TraceMessage::Topology(m) => self.log_mesh_topology(m)?,
             TraceMessage::Frame(m) => self.log_mesh_frame(m)?,
+            TraceMessage::YarnNodes(m) => {
+                self.held.insert(m.yarns.clone(), held_vertices(m));
+            }
             TraceMessage::Yarns(m) => self.log_yarns(m)?,
             TraceMessage::TetTopology(m) => self.log_tet_topology(m)?,
             TraceMessage::TetFrame(m) => self.log_tet_frame(m)?,
@@ -160,6 +165,16 @@ impl<'a> RerunLogger<'a> {
             radii.push((yarn_radii.iter().sum::<f64>() / yarn_radii.len().max(1) as f64) as f32);
         }
         self.rec.log(format!("yarns/{}", m.yarns), &LineStrips3D::new(strips).with_radii(radii))?;
+        if let Some(held) = self.held.get(&m.yarns).filter(|h| !h.is_empty()) {
+            let (points, radii): (Vec<[f32; 3]>, Vec<f32>) = held
+                .iter()
+                .filter_map(|&v| {
+                    Some((m.positions_m.get(v)?.map(|x| x as f32), 1.5 * *m.radii_m.get(v)? as f32))
+                })
+                .unzip();
+            let handles = Points3D::new(points).with_radii(radii).with_colors([HANDLE_COLOUR]);
+            self.rec.log(format!("yarns/{}/handles", m.yarns), &handles)?;
+        }
         Ok(())
     }
 
@@ -196,6 +211,14 @@ impl<'a> RerunLogger<'a> {
         }
         Ok(())
     }
+}
+
+/// Colour of the vertices handles hold (orange).
+const HANDLE_COLOUR: [u8; 3] = [255, 140, 0];
+
+/// The vertices of a yarn set that handles hold (node type `HANDLE`).
+fn held_vertices(nodes: &YarnNodes) -> Vec<usize> {
+    nodes.node_type.iter().enumerate().filter(|&(_, &t)| t == YarnNodes::HANDLE).map(|(v, _)| v).collect()
 }
 
 /// Logs every message of a trace into `rec`. A truncated trace is logged up to the cut, and
@@ -247,6 +270,31 @@ fn vertex_normals(positions_m: &[[f64; 3]], triangles: &[[u32; 3]]) -> Vec<[f32;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_held_vertices_are_drawn_as_handles() {
+        let nodes = YarnNodes {
+            yarns: "stock".into(),
+            rest_positions_m: vec![[0.0; 3]; 5],
+            node_type: vec![YarnNodes::HANDLE, 0, 0, YarnNodes::HANDLE, 0],
+            edges: vec![[0, 1], [1, 2], [3, 4]],
+        };
+        assert_eq!(held_vertices(&nodes), vec![0, 3]);
+        let (rec, _storage) = rerun::RecordingStreamBuilder::new("test").memory().expect("a recording");
+        let mut logger = RerunLogger::new(&rec);
+        assert!(logger.log(&TraceMessage::YarnNodes(nodes)).expect("logs"));
+        let frame = YarnFrame {
+            yarns: "stock".into(),
+            frame: 0,
+            time_s: 0.0,
+            positions_m: vec![[0.0; 3]; 5],
+            edge_twist_rad: vec![0.0; 5],
+            radii_m: vec![1e-3; 5],
+            yarn_ranges: vec![[0, 3], [3, 2]],
+        };
+        assert!(logger.log(&TraceMessage::Yarns(frame)).expect("logs"));
+        assert_eq!(logger.held["stock"], vec![0, 3]);
+    }
 
     #[test]
     fn two_tets_sharing_a_face_have_six_boundary_faces_facing_out() {
